@@ -1,0 +1,257 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
+ */
+
+#pragma once
+
+#include <pcl_selective_seg/octree_pointcloud_normal_variance.h>
+
+#include <pcl/common/point_tests.h>
+#include <pcl/octree/impl/octree_base.hpp>
+#include <pcl/octree/impl/octree_pointcloud.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace pcl {
+namespace selective_seg {
+namespace detail {
+
+/** \brief Angle difference wrapped into (-pi, pi]. */
+inline double
+wrapAngle(double a)
+{
+  if (a > M_PI)
+    return a - 2.0 * M_PI;
+  if (a <= -M_PI)
+    return a + 2.0 * M_PI;
+  return a;
+}
+
+} // namespace detail
+
+template <typename PointT>
+OctreePointCloudNormalVariance<PointT>::OctreePointCloudNormalVariance(double resolution)
+: OctreeT(resolution)
+{}
+
+template <typename PointT>
+void
+OctreePointCloudNormalVariance<PointT>::setInputNormals(const NormalCloudConstPtr& normals,
+                                                        const AreasConstPtr& areas)
+{
+  normals_ = normals;
+  areas_ = areas;
+}
+
+template <typename PointT>
+bool
+OctreePointCloudNormalVariance<PointT>::isValidPoint(pcl::index_t index) const
+{
+  const auto i = static_cast<std::size_t>(index);
+  if (i >= this->input_->size() || i >= normals_->size() || i >= areas_->size())
+    return false;
+  const double area = (*areas_)[i];
+  return pcl::isFinite((*this->input_)[i]) && pcl::isNormalFinite((*normals_)[i]) &&
+         std::isfinite(area) && area > 0.0;
+}
+
+template <typename PointT>
+bool
+OctreePointCloudNormalVariance<PointT>::addPointsFromInputCloud()
+{
+  if (!this->input_ || !normals_ || !areas_)
+    return false;
+  pcl::Indices valid;
+  const auto consider = [&](pcl::index_t i) {
+    if (isValidPoint(i))
+      valid.push_back(i);
+  };
+  if (this->indices_)
+    std::for_each(this->indices_->begin(), this->indices_->end(), consider);
+  else
+    for (pcl::index_t i = 0; i < static_cast<pcl::index_t>(this->input_->size()); ++i)
+      consider(i);
+  if (valid.empty())
+    return false;
+
+  Eigen::Array3d lo = Eigen::Array3d::Constant(std::numeric_limits<double>::max());
+  Eigen::Array3d hi = -lo;
+  for (const auto i : valid) {
+    const Eigen::Array3d p = (*this->input_)[i].getVector3fMap().template cast<double>();
+    lo = lo.min(p);
+    hi = hi.max(p);
+  }
+  // Pad the top so that no point sits exactly on the box's upper faces.
+  hi += 0.01 * this->resolution_;
+  this->defineBoundingBox(lo.x(), lo.y(), lo.z(), hi.x(), hi.y(), hi.z());
+  for (const auto i : valid)
+    this->addPointIdx(i);
+  return true;
+}
+
+template <typename PointT>
+void
+OctreePointCloudNormalVariance<PointT>::orderPoints(const pcl::octree::OctreeNode* node)
+{
+  if (node->getNodeType() == pcl::octree::LEAF_NODE) {
+    auto& container = const_cast<LeafNode*>(static_cast<const LeafNode*>(node))
+                          ->getContainer();
+    container.setFirstOrderedPoint(ordered_indices_.size());
+    const Eigen::Matrix3d to_sensor =
+        sensor_orientation_.toRotationMatrix().transpose().template cast<double>();
+    for (const auto i : container.getPointIndicesVector()) {
+      const Eigen::Vector3d m =
+          -(to_sensor * (*normals_)[i].getNormalVector3fMap().template cast<double>())
+               .normalized();
+      ordered_indices_.push_back(i);
+      ordered_normals_.push_back(m);
+      ordered_theta_.push_back(std::atan2(m.x(), m.z()));
+      ordered_phi_.push_back(std::atan2(m.y(), m.z()));
+      ordered_areas_.push_back((*areas_)[i]);
+    }
+    return;
+  }
+  const auto* branch = static_cast<const BranchNode*>(node);
+  for (unsigned char c = 0; c < 8; ++c)
+    if (const auto* child = branch->getChildPtr(c))
+      orderPoints(child);
+}
+
+template <typename PointT>
+std::pair<std::size_t, std::size_t>
+OctreePointCloudNormalVariance<PointT>::nodeRange(const pcl::octree::OctreeNode* node) const
+{
+  const auto* first = node;
+  while (first->getNodeType() == pcl::octree::BRANCH_NODE) {
+    const auto* branch = static_cast<const BranchNode*>(first);
+    unsigned char c = 0;
+    while (!branch->getChildPtr(c))
+      ++c;
+    first = branch->getChildPtr(c);
+  }
+  const auto* last = node;
+  while (last->getNodeType() == pcl::octree::BRANCH_NODE) {
+    const auto* branch = static_cast<const BranchNode*>(last);
+    int c = 7;
+    while (!branch->getChildPtr(static_cast<unsigned char>(c)))
+      --c;
+    last = branch->getChildPtr(static_cast<unsigned char>(c));
+  }
+  const auto& first_leaf = static_cast<const LeafNode*>(first)->getContainer();
+  const auto& last_leaf = static_cast<const LeafNode*>(last)->getContainer();
+  return {first_leaf.getFirstOrderedPoint(),
+          last_leaf.getFirstOrderedPoint() + last_leaf.getSize()};
+}
+
+template <typename PointT>
+typename OctreePointCloudNormalVariance<PointT>::NodeStatistics
+OctreePointCloudNormalVariance<PointT>::computeStatistics(std::size_t begin,
+                                                          std::size_t end) const
+{
+  NodeStatistics s;
+  for (std::size_t k = begin; k < end; ++k) {
+    const double w = 1.0 / ordered_areas_[k]; // eq. 4: weight 1 / A_p
+    s.sum_weighted_normal += w * ordered_normals_[k];
+    s.sum_weight += w;
+    s.sum_area += ordered_areas_[k]; // eq. 6
+  }
+  const Eigen::Vector3d mean = s.sum_weighted_normal.normalized();
+  const double theta_v = std::atan2(mean.x(), mean.z());
+  const double phi_v = std::atan2(mean.y(), mean.z());
+  double var_theta = 0.0, var_phi = 0.0;
+  for (std::size_t k = begin; k < end; ++k) {
+    const double w = 1.0 / ordered_areas_[k];
+    const double dt = detail::wrapAngle(ordered_theta_[k] - theta_v);
+    const double dp = detail::wrapAngle(ordered_phi_[k] - phi_v);
+    var_theta += w * dt * dt; // eq. 5
+    var_phi += w * dp * dp;
+  }
+  s.sigma_theta = std::sqrt(var_theta / s.sum_weight);
+  s.sigma_phi = std::sqrt(var_phi / s.sum_weight);
+  return s;
+}
+
+template <typename PointT>
+void
+OctreePointCloudNormalVariance<PointT>::splitOrKeep(const pcl::octree::OctreeNode* node,
+                                                    const pcl::octree::OctreeKey& key,
+                                                    std::uint32_t depth,
+                                                    double max_std_dev,
+                                                    std::size_t min_points_to_split)
+{
+  const auto range = nodeRange(node);
+  const NodeStatistics s = computeStatistics(range.first, range.second);
+  const bool varies = s.sigma_theta > max_std_dev || s.sigma_phi > max_std_dev;
+  const bool can_split = node->getNodeType() == pcl::octree::BRANCH_NODE &&
+                         range.second - range.first >= min_points_to_split;
+  if (varies && can_split) {
+    const auto* branch = static_cast<const BranchNode*>(node);
+    for (unsigned char c = 0; c < 8; ++c) {
+      if (const auto* child = branch->getChildPtr(c)) {
+        pcl::octree::OctreeKey child_key = key;
+        child_key.pushBranch(c);
+        splitOrKeep(child, child_key, depth + 1, max_std_dev, min_points_to_split);
+      }
+    }
+    return;
+  }
+  AdaptiveLeaf leaf;
+  leaf.key = key;
+  leaf.depth = depth;
+  leaf.begin = range.first;
+  leaf.end = range.second;
+  const Eigen::Matrix3d to_cloud =
+      sensor_orientation_.toRotationMatrix().template cast<double>();
+  leaf.normal = (-(to_cloud * s.sum_weighted_normal)).normalized().template cast<float>();
+  leaf.area = s.sum_area;
+  leaf.sigma_theta = static_cast<float>(s.sigma_theta);
+  leaf.sigma_phi = static_cast<float>(s.sigma_phi);
+  leaves_.push_back(leaf);
+}
+
+template <typename PointT>
+void
+OctreePointCloudNormalVariance<PointT>::computeAdaptiveLeaves(
+    double max_std_dev, std::size_t min_points_to_split)
+{
+  leaves_.clear();
+  ordered_indices_.clear();
+  ordered_normals_.clear();
+  ordered_theta_.clear();
+  ordered_phi_.clear();
+  ordered_areas_.clear();
+  if (this->leaf_count_ == 0 || !this->root_node_)
+    return;
+  ordered_indices_.reserve(this->indices_ ? this->indices_->size() : this->input_->size());
+  orderPoints(this->root_node_);
+  splitOrKeep(this->root_node_,
+              pcl::octree::OctreeKey(),
+              0,
+              max_std_dev,
+              std::max<std::size_t>(min_points_to_split, 2));
+}
+
+template <typename PointT>
+double
+OctreePointCloudNormalVariance<PointT>::getVoxelSideLength(std::uint32_t depth) const
+{
+  return this->resolution_ *
+         static_cast<double>(1ULL << (this->octree_depth_ - std::min(depth, this->octree_depth_)));
+}
+
+template <typename PointT>
+Eigen::Vector3f
+OctreePointCloudNormalVariance<PointT>::getVoxelCentre(const AdaptiveLeaf& leaf) const
+{
+  const double side = getVoxelSideLength(leaf.depth);
+  return Eigen::Vector3f(static_cast<float>((leaf.key.x + 0.5) * side + this->min_x_),
+                         static_cast<float>((leaf.key.y + 0.5) * side + this->min_y_),
+                         static_cast<float>((leaf.key.z + 0.5) * side + this->min_z_));
+}
+
+} // namespace selective_seg
+} // namespace pcl

@@ -1,0 +1,397 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
+ */
+
+#pragma once
+
+#include <pcl_selective_seg/impl/spherical_delaunay.hpp>
+#include <pcl_selective_seg/region_merging.h>
+#include <pcl_selective_seg/selective_segmentation.h>
+
+#include <pcl/common/time.h>
+#include <pcl/console/print.h>
+#include <pcl/conversions.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+namespace pcl {
+namespace selective_seg {
+
+template <typename PointT>
+bool
+SelectiveSegmentation<PointT>::initCompute()
+{
+  if (!input_) {
+    PCL_ERROR("[pcl::selective_seg::%s::extract] no input cloud: call setInputCloud() "
+              "first\n",
+              getClassName().c_str());
+    return false;
+  }
+  if (!pcl::PCLBase<PointT>::initCompute())
+    return false;
+  std::string why;
+  if (!params_.validate(&why)) {
+    PCL_ERROR("[pcl::selective_seg::%s::extract] %s\n", getClassName().c_str(), why.c_str());
+    return false;
+  }
+  return true;
+}
+
+template <typename PointT>
+bool
+SelectiveSegmentation<PointT>::fail(const char* stage, const std::string& why)
+{
+  PCL_ERROR("[pcl::selective_seg::%s::%s] %s\n", getClassName().c_str(), stage, why.c_str());
+  const PointCounts counts = result_.counts;
+  result_.clear();
+  result_.counts = counts;
+  octree_.reset();
+  normals_.reset();
+  this->deinitCompute();
+  return false;
+}
+
+template <typename PointT>
+bool
+SelectiveSegmentation<PointT>::triangulate()
+{
+  delaunay_.setInputCloud(input_);
+  delaunay_.setIndices(indices_);
+  delaunay_.setBackend(params_.delaunay_backend);
+  delaunay_.setAngleQuantization(params_.angle_quantization);
+  if (!delaunay_.triangulate())
+    return fail("extract", "the spherical triangulation failed (reason above)");
+  const SphericalTriangulation& tri = delaunay_.getTriangulation();
+  result_.counts.outside_indices = tri.num_outside_indices;
+  result_.counts.non_finite = tri.num_non_finite;
+  result_.counts.behind_sensor = tri.num_behind_sensor;
+  result_.num_vertices = tri.vertex_point.size();
+  if (tri.vertex_point.empty())
+    return fail("extract",
+                "no usable point among " + std::to_string(input_->size()) + ": " +
+                    std::to_string(tri.num_non_finite) + " non-finite, " +
+                    std::to_string(tri.num_behind_sensor) +
+                    " at or behind the sensor plane (z <= 0 in the sensor frame; check "
+                    "sensor_origin_/sensor_orientation_ or setSensorPose()), " +
+                    std::to_string(tri.num_outside_indices) + " outside the indices");
+  if (tri.triangles.empty())
+    return fail("extract",
+                "the " + std::to_string(tri.vertex_point.size()) +
+                    " distinct viewing directions are fewer than three or all on one "
+                    "line in (theta, phi): there is no surface to triangulate");
+  return true;
+}
+
+template <typename PointT>
+bool
+SelectiveSegmentation<PointT>::computeNormals()
+{
+  const SphericalTriangulation& tri = delaunay_.getTriangulation();
+  const auto& positions = tri.vertex_positions; // sensor frame: the viewpoint is 0
+  const Eigen::Vector3f viewpoint = Eigen::Vector3f::Zero();
+  computeTriangleNormals(
+      positions, tri.triangles, viewpoint, triangle_normals_, triangle_areas_);
+  markEdgeOnTriangles(positions,
+                      tri.triangles,
+                      triangle_normals_,
+                      viewpoint,
+                      params_.max_view_incidence_angle,
+                      triangle_edge_on_);
+  vertex_areas_ = std::make_shared<std::vector<double>>();
+  computeVertexNormals(positions.size(),
+                       tri.triangles,
+                       triangle_normals_,
+                       triangle_areas_,
+                       vertex_normals_,
+                       *vertex_areas_);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  normals_.reset(
+      new NormalCloud(input_->width, input_->height, pcl::Normal(nan, nan, nan, nan)));
+  normals_->header = input_->header;
+  normals_->is_dense = false;
+  const Eigen::Matrix3f to_cloud = sensorToCloud();
+  bool any = false;
+  for (std::size_t i = 0; i < input_->size(); ++i) {
+    const pcl::index_t v = tri.point_vertex[i];
+    if (v < 0 || !vertex_normals_[v].allFinite())
+      continue;
+    (*normals_)[i].getNormalVector3fMap() = to_cloud * vertex_normals_[v];
+    (*normals_)[i].curvature = 0.0f;
+    any = true;
+  }
+  result_.median_spacing = medianEdgeLength(positions, tri.triangles);
+  if (!any)
+    return fail("extract",
+                "every triangle is degenerate (zero 3-D area): the points give no "
+                "surface normal");
+  return true;
+}
+
+template <typename PointT>
+bool
+SelectiveSegmentation<PointT>::buildOctree()
+{
+  const SphericalTriangulation& tri = delaunay_.getTriangulation();
+  const std::size_t num_vertices = tri.vertex_positions.size();
+  auto vertices = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  auto normals = pcl::make_shared<NormalCloud>();
+  vertices->resize(num_vertices);
+  normals->resize(num_vertices);
+  Eigen::Array3f lo = Eigen::Array3f::Constant(std::numeric_limits<float>::max());
+  Eigen::Array3f hi = -lo;
+  for (std::size_t v = 0; v < num_vertices; ++v) {
+    (*vertices)[v].getVector3fMap() = tri.vertex_positions[v];
+    (*normals)[v].getNormalVector3fMap() = vertex_normals_[v];
+    if (vertex_normals_[v].allFinite()) {
+      lo = lo.min(tri.vertex_positions[v].array());
+      hi = hi.max(tri.vertex_positions[v].array());
+    }
+  }
+  // The finest voxel: the parameter, or a multiple of the point spacing, but never so
+  // small that the tree would exceed its maximum depth.
+  const double extent = (hi - lo).template cast<double>().maxCoeff();
+  double resolution = params_.min_voxel_size > 0.0
+                          ? params_.min_voxel_size
+                          : params_.min_voxel_size_factor * result_.median_spacing;
+  resolution = std::max(resolution, extent / std::ldexp(1.0, params_.max_octree_depth));
+  if (!(resolution > 0.0) || !std::isfinite(resolution))
+    resolution = extent > 0.0 && std::isfinite(extent) ? extent : 1.0;
+  result_.min_voxel_size = resolution;
+
+  octree_ = pcl::make_shared<Octree>(resolution);
+  octree_->setInputCloud(vertices);
+  octree_->setInputNormals(normals, vertex_areas_);
+  if (!octree_->addPointsFromInputCloud())
+    return fail("extract", "no point with a normal to insert into the octree");
+  octree_->computeAdaptiveLeaves(params_.max_normal_std_dev,
+                                 static_cast<std::size_t>(params_.min_points_to_split));
+
+  vertex_leaf_.assign(num_vertices, -1);
+  const auto& leaves = octree_->getAdaptiveLeaves();
+  const auto& ordered = octree_->getOrderedIndices();
+  for (std::size_t l = 0; l < leaves.size(); ++l)
+    for (std::size_t k = leaves[l].begin; k < leaves[l].end; ++k)
+      vertex_leaf_[ordered[k]] = static_cast<pcl::index_t>(l);
+  return true;
+}
+
+template <typename PointT>
+void
+SelectiveSegmentation<PointT>::rankSegments(const std::vector<pcl::index_t>& vertex_segment,
+                                            const Vector3fVector& segment_normals,
+                                            std::vector<std::uint32_t>& segment_label)
+{
+  const SphericalTriangulation& tri = delaunay_.getTriangulation();
+  const std::size_t num_segments = segment_normals.size();
+  std::vector<std::size_t> sizes(num_segments, 0);
+  for (const auto v : tri.point_vertex)
+    if (v >= 0 && vertex_segment[v] >= 0)
+      ++sizes[vertex_segment[v]];
+  // Largest first; ties keep the (data-determined) creation order.
+  std::vector<std::size_t> order(num_segments);
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return sizes[a] > sizes[b];
+  });
+  segment_label.assign(num_segments, 0);
+  result_.segments.resize(num_segments);
+  for (std::size_t r = 0; r < num_segments; ++r) {
+    segment_label[order[r]] = static_cast<std::uint32_t>(r + 1);
+    result_.segments[r].label = static_cast<std::uint32_t>(r + 1);
+    result_.segments[r].num_points = sizes[order[r]];
+    result_.segments[r].normal = sensorToCloud() * segment_normals[order[r]];
+  }
+  result_.labels.assign(input_->size(), 0);
+  for (std::size_t i = 0; i < input_->size(); ++i) {
+    const pcl::index_t v = tri.point_vertex[i];
+    if (v >= 0 && vertex_segment[v] >= 0)
+      result_.labels[i] = segment_label[vertex_segment[v]];
+  }
+}
+
+template <typename PointT>
+void
+SelectiveSegmentation<PointT>::fillMeshAndLeaves(
+    const std::vector<std::uint32_t>& vertex_labels,
+    const std::vector<pcl::index_t>& leaf_segment,
+    const std::vector<std::uint32_t>& segment_label)
+{
+  const SphericalTriangulation& tri = delaunay_.getTriangulation();
+  SegmentedMesh& mesh = result_.mesh;
+  mesh.triangles.resize(tri.triangles.size());
+  for (std::size_t t = 0; t < tri.triangles.size(); ++t)
+    for (int i = 0; i < 3; ++i)
+      mesh.triangles[t][i] = tri.vertex_point[tri.triangles[t][i]];
+  mesh.neighbours = tri.neighbours;
+  const Eigen::Matrix3f to_cloud = sensorToCloud();
+  mesh.normals.resize(triangle_normals_.size());
+  for (std::size_t t = 0; t < triangle_normals_.size(); ++t)
+    mesh.normals[t] = to_cloud * triangle_normals_[t];
+  mesh.areas = triangle_areas_;
+  Vector3fVector label_normals; // sensor frame, like the triangle normals
+  for (const auto& s : result_.segments)
+    label_normals.push_back(to_cloud.transpose() * s.normal);
+  classifyTriangles(tri.triangles,
+                    triangle_normals_,
+                    &triangle_edge_on_,
+                    vertex_labels,
+                    label_normals,
+                    params_.max_edge_triangle_angle,
+                    mesh.labels,
+                    mesh.classes);
+
+  const auto& leaves = octree_->getAdaptiveLeaves();
+  result_.leaves.resize(leaves.size());
+  for (std::size_t l = 0; l < leaves.size(); ++l) {
+    OctreeLeaf& out = result_.leaves[l];
+    out.centre = delaunay_.getSensorPose() * octree_->getVoxelCentre(leaves[l]);
+    out.size = static_cast<float>(octree_->getVoxelSideLength(leaves[l].depth));
+    out.depth = leaves[l].depth;
+    out.label = segment_label[leaf_segment[l]];
+    out.normal = to_cloud * leaves[l].normal;
+    out.sigma_theta = leaves[l].sigma_theta;
+    out.sigma_phi = leaves[l].sigma_phi;
+    out.area = leaves[l].area;
+    out.num_points = static_cast<std::uint32_t>(leaves[l].end - leaves[l].begin);
+    result_.segments[out.label - 1].area += out.area;
+    ++result_.segments[out.label - 1].num_leaves;
+  }
+}
+
+template <typename PointT>
+void
+SelectiveSegmentation<PointT>::mergeAndLabel()
+{
+  const SphericalTriangulation& tri = delaunay_.getTriangulation();
+  const auto& leaves = octree_->getAdaptiveLeaves();
+  Vector3fVector leaf_normals(leaves.size());
+  std::vector<double> leaf_areas(leaves.size());
+  for (std::size_t l = 0; l < leaves.size(); ++l) {
+    leaf_normals[l] = leaves[l].normal;
+    leaf_areas[l] = leaves[l].area;
+  }
+  MergeInput in;
+  in.leaf_normals = &leaf_normals;
+  in.leaf_areas = &leaf_areas;
+  in.vertex_leaf = &vertex_leaf_;
+  in.triangles = &tri.triangles;
+  in.triangle_normals = &triangle_normals_;
+  in.triangle_edge_on = &triangle_edge_on_;
+  in.max_merge_angle = params_.max_merge_angle;
+  in.max_edge_triangle_angle = params_.max_edge_triangle_angle;
+  std::vector<pcl::index_t> leaf_segment;
+  Vector3fVector segment_normals;
+  mergeSeedSegments(in, leaf_segment, segment_normals);
+
+  std::vector<pcl::index_t> vertex_segment(vertex_leaf_.size(), -1);
+  for (std::size_t v = 0; v < vertex_leaf_.size(); ++v)
+    if (vertex_leaf_[v] >= 0)
+      vertex_segment[v] = leaf_segment[vertex_leaf_[v]];
+  std::vector<std::uint32_t> segment_label;
+  rankSegments(vertex_segment, segment_normals, segment_label);
+  std::vector<std::uint32_t> vertex_labels(vertex_segment.size(), 0);
+  for (std::size_t v = 0; v < vertex_segment.size(); ++v)
+    if (vertex_segment[v] >= 0)
+      vertex_labels[v] = segment_label[vertex_segment[v]];
+  fillMeshAndLeaves(vertex_labels, leaf_segment, segment_label);
+
+  PointCounts& counts = result_.counts;
+  for (std::size_t i = 0; i < input_->size(); ++i) {
+    const pcl::index_t v = tri.point_vertex[i];
+    if (v < 0)
+      continue;
+    if (result_.labels[i] == 0)
+      ++counts.without_normal;
+    else {
+      ++counts.labeled;
+      counts.shared_vertex += (tri.vertex_point[v] != static_cast<pcl::index_t>(i));
+    }
+  }
+}
+
+template <typename PointT>
+bool
+SelectiveSegmentation<PointT>::extract(std::vector<pcl::PointIndices>& clusters)
+{
+  clusters.clear();
+  result_.clear();
+  octree_.reset();
+  normals_.reset();
+  pcl::StopWatch total;
+  if (!initCompute()) {
+    this->deinitCompute();
+    return false;
+  }
+  pcl::StopWatch watch;
+  if (!triangulate())
+    return false;
+  result_.timings.delaunay = watch.getTimeSeconds();
+  watch.reset();
+  if (!computeNormals())
+    return false;
+  result_.timings.normals = watch.getTimeSeconds();
+  watch.reset();
+  if (!buildOctree())
+    return false;
+  result_.timings.octree = watch.getTimeSeconds();
+  watch.reset();
+  mergeAndLabel();
+  clusters.resize(result_.segments.size());
+  for (std::size_t i = 0; i < result_.labels.size(); ++i)
+    if (result_.labels[i] > 0)
+      clusters[result_.labels[i] - 1].indices.push_back(static_cast<pcl::index_t>(i));
+  for (auto& c : clusters)
+    c.header = input_->header;
+  result_.timings.merge = watch.getTimeSeconds();
+  if (result_.segments.empty())
+    PCL_WARN("[pcl::selective_seg::%s::extract] no segment found\n", getClassName().c_str());
+  this->deinitCompute();
+  result_.timings.total = total.getTimeSeconds();
+  return true;
+}
+
+template <typename PointT>
+typename SelectiveSegmentation<PointT>::LabeledCloud::Ptr
+SelectiveSegmentation<PointT>::getLabeledCloud() const
+{
+  // A successful run has at least one segment.
+  if (!input_ || result_.segments.empty() || result_.labels.size() != input_->size())
+    return nullptr;
+  auto out = pcl::make_shared<LabeledCloud>(input_->width, input_->height);
+  out->header = input_->header;
+  out->is_dense = input_->is_dense;
+  out->sensor_origin_ = input_->sensor_origin_;
+  out->sensor_orientation_ = input_->sensor_orientation_;
+  for (std::size_t i = 0; i < input_->size(); ++i) {
+    (*out)[i].getVector3fMap() = (*input_)[i].getVector3fMap();
+    (*out)[i].label = result_.labels[i];
+  }
+  return out;
+}
+
+template <typename PointT>
+void
+SelectiveSegmentation<PointT>::getPolygonMesh(pcl::PolygonMesh& mesh) const
+{
+  mesh = pcl::PolygonMesh();
+  if (!input_ || result_.segments.empty())
+    return;
+  pcl::toPCLPointCloud2(*input_, mesh.cloud);
+  mesh.header = input_->header;
+  mesh.polygons.resize(result_.mesh.triangles.size());
+  for (std::size_t t = 0; t < mesh.polygons.size(); ++t) {
+    const Triangle& tri = result_.mesh.triangles[t];
+    mesh.polygons[t].vertices.assign(tri.begin(), tri.end());
+  }
+}
+
+} // namespace selective_seg
+} // namespace pcl
+
+#define PCL_INSTANTIATE_SelectiveSegmentation(T)                                      \
+  template class PCL_EXPORTS pcl::selective_seg::SelectiveSegmentation<T>;

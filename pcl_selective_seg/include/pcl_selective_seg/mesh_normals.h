@@ -1,0 +1,87 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
+ */
+
+#pragma once
+
+#include <pcl_selective_seg/delaunay_2d.h>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <pcl/pcl_macros.h>
+
+#include <vector>
+
+namespace pcl {
+namespace selective_seg {
+
+/** \brief 3-vectors (Eigen::Vector3f needs no aligned allocator). */
+using Vector3fVector = std::vector<Eigen::Vector3f>;
+
+/** \brief Unit normal and 3-D area of each triangle (paper, Sec. III.B).
+ *
+ * \param[in] positions #V vertex positions [m]
+ * \param[in] triangles #T triangles over vertex ids
+ * \param[in] viewpoint sensor origin in the frame of \a positions [m]; each normal is
+ *            oriented toward it (n . (centroid - viewpoint) <= 0)
+ * \param[out] normals #T unit normals; NaN for a degenerate (zero-area) triangle
+ * \param[out] areas #T areas A_t [m^2], computed in double precision (finite for any
+ *             finite float input)
+ */
+PCL_EXPORTS void
+computeTriangleNormals(const Vector3fVector& positions,
+                       const std::vector<Triangle>& triangles,
+                       const Eigen::Vector3f& viewpoint,
+                       Vector3fVector& normals,
+                       std::vector<double>& areas);
+
+/** \brief Point normals (eq. 2) and point areas (eq. 3).
+ *
+ * N_p = normalize(sum over incident triangles t of N_t / A_t); triangles with zero or
+ * non-finite area or normal are skipped. A_p = sum of A_t over the incident triangles.
+ *
+ * \param[in] num_vertices #V
+ * \param[in] triangles #T triangles over vertex ids
+ * \param[in] normals #T triangle normals, from computeTriangleNormals()
+ * \param[in] areas #T triangle areas [m^2]
+ * \param[out] vertex_normals #V unit normals; NaN where no valid triangle is incident
+ *             or the weighted normals cancel
+ * \param[out] vertex_areas #V areas A_p [m^2]
+ */
+PCL_EXPORTS void
+computeVertexNormals(std::size_t num_vertices,
+                     const std::vector<Triangle>& triangles,
+                     const Vector3fVector& normals,
+                     const std::vector<double>& areas,
+                     Vector3fVector& vertex_normals,
+                     std::vector<double>& vertex_areas);
+
+/** \brief Flag the triangles seen edge-on from the viewpoint.
+ *
+ * A triangle whose normal makes more than \a max_incidence with the line of sight to its
+ * centroid spans a depth discontinuity rather than a surface.
+ *
+ * \param[in] positions #V vertex positions [m]
+ * \param[in] triangles #T triangles
+ * \param[in] normals #T unit normals (NaN: degenerate, flagged)
+ * \param[in] viewpoint sensor origin [m]
+ * \param[in] max_incidence [rad]; pi/2 or more flags only degenerate triangles
+ * \param[out] edge_on #T 1 = seen edge-on
+ */
+PCL_EXPORTS void
+markEdgeOnTriangles(const Vector3fVector& positions,
+                    const std::vector<Triangle>& triangles,
+                    const Vector3fVector& normals,
+                    const Eigen::Vector3f& viewpoint,
+                    double max_incidence,
+                    std::vector<std::uint8_t>& edge_on);
+
+/** \brief Median 3-D length of the triangles' edges [m] (each interior edge counted
+ * twice); 0 for an empty mesh. The octree's automatic minimum voxel size scales it. */
+PCL_EXPORTS double
+medianEdgeLength(const Vector3fVector& positions, const std::vector<Triangle>& triangles);
+
+} // namespace selective_seg
+} // namespace pcl

@@ -1,0 +1,166 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
+ */
+
+#pragma once
+
+#include <pcl_selective_seg/octree_normal_variance_container.h>
+
+#include <Eigen/Geometry>
+#include <pcl/octree/octree_pointcloud.h>
+#include <pcl/point_types.h>
+
+#include <memory>
+#include <vector>
+
+namespace pcl {
+namespace selective_seg {
+
+/** \brief A node of the multi-resolution octree taken as a leaf (a seed segment). */
+struct AdaptiveLeaf {
+  pcl::octree::OctreeKey key; ///< key of the node at its own depth
+  std::uint32_t depth = 0;    ///< 0 = root
+  std::size_t begin = 0;      ///< its points: getOrderedIndices()[begin, end)
+  std::size_t end = 0;
+  Eigen::Vector3f normal = Eigen::Vector3f::Zero(); ///< N_v (eq. 4), input orientation
+  double area = 0.0;          ///< A_v = sum of A_p (eq. 6)
+  float sigma_theta = 0.0f;   ///< eq. 5 [rad]
+  float sigma_phi = 0.0f;     ///< eq. 5 [rad]
+};
+
+/** \brief Multi-resolution octree whose voxels split while their normals vary (paper,
+ * Sec. III.C, eq. 3-5).
+ *
+ * The tree is a PCL octree built to the finest level (the resolution, i.e. the minimum
+ * voxel size). computeAdaptiveLeaves() then walks it from the root and keeps as leaves
+ * the highest nodes whose weighted standard deviation of the normal angles (eq. 5) is
+ * at most the threshold on both axes, or that hold fewer than a minimum number of
+ * points, or that are finest voxels.
+ *
+ * Normal angles: theta = atan2(m_x, m_z), phi = atan2(m_y, m_z) of m = -R^T n, the
+ * normal n (oriented toward the sensor, as pcl::flipNormalTowardsViewpoint leaves it)
+ * reversed and expressed in the sensor frame (R = sensor orientation). A surface facing
+ * the sensor then sits near (0, 0) rather than at the +-pi seam. Deviations from the
+ * voxel's angle are wrapped into (-pi, pi].
+ *
+ * The bounding box is taken from the points before insertion, so the tree, its leaves
+ * and their order do not depend on the order of the points.
+ */
+template <typename PointT>
+class OctreePointCloudNormalVariance
+: public pcl::octree::OctreePointCloud<PointT,
+                                       OctreeNormalVarianceContainer,
+                                       pcl::octree::OctreeContainerEmpty> {
+public:
+  using Ptr = pcl::shared_ptr<OctreePointCloudNormalVariance<PointT>>;
+  using ConstPtr = pcl::shared_ptr<const OctreePointCloudNormalVariance<PointT>>;
+  using OctreeT = pcl::octree::OctreePointCloud<PointT,
+                                                OctreeNormalVarianceContainer,
+                                                pcl::octree::OctreeContainerEmpty>;
+  using NormalCloud = pcl::PointCloud<pcl::Normal>;
+  using NormalCloudConstPtr = typename NormalCloud::ConstPtr;
+  using AreasConstPtr = std::shared_ptr<const std::vector<double>>;
+
+  /** \param[in] resolution finest voxel edge [m], > 0 */
+  explicit OctreePointCloudNormalVariance(double resolution);
+
+  /** \brief Per-point normals and point areas A_p (eq. 3), indexed like the input
+   * cloud. Points whose normal is not finite or whose area is not positive are skipped
+   * by addPointsFromInputCloud(). */
+  void
+  setInputNormals(const NormalCloudConstPtr& normals, const AreasConstPtr& areas);
+
+  /** \brief Orientation of the sensor in the cloud frame (the angles of eq. 5 are
+   * measured in the sensor frame). Default: identity. */
+  void
+  setSensorOrientation(const Eigen::Quaternionf& orientation)
+  {
+    sensor_orientation_ = orientation;
+  }
+
+  /** \brief Fit the bounding box to the valid points and insert them. Replaces
+   * OctreePointCloud::addPointsFromInputCloud (which ignores normals and grows the
+   * box in insertion order). \return false when no point is valid. */
+  bool
+  addPointsFromInputCloud();
+
+  /** \brief Split from the root while sigma_theta or sigma_phi > max_std_dev [rad]
+   * and the node holds at least min_points_to_split points (eq. 4-5). */
+  void
+  computeAdaptiveLeaves(double max_std_dev, std::size_t min_points_to_split);
+
+  /** \brief The leaves, in depth-first (Morton) order. */
+  const std::vector<AdaptiveLeaf>&
+  getAdaptiveLeaves() const
+  {
+    return leaves_;
+  }
+
+  /** \brief Input point indices in depth-first order; each leaf owns a range. */
+  const pcl::Indices&
+  getOrderedIndices() const
+  {
+    return ordered_indices_;
+  }
+
+  /** \brief Edge length of a node at the given depth [m]. */
+  double
+  getVoxelSideLength(std::uint32_t depth) const;
+
+  /** \brief Centre of a node [m], cloud frame. */
+  Eigen::Vector3f
+  getVoxelCentre(const AdaptiveLeaf& leaf) const;
+
+protected:
+  using BranchNode = typename OctreeT::BranchNode;
+  using LeafNode = typename OctreeT::LeafNode;
+
+  struct NodeStatistics {
+    Eigen::Vector3d sum_weighted_normal = Eigen::Vector3d::Zero();
+    double sum_weight = 0.0;
+    double sum_area = 0.0;
+    double sigma_theta = 0.0;
+    double sigma_phi = 0.0;
+  };
+
+  bool
+  isValidPoint(pcl::index_t index) const;
+
+  /** \brief Order the points depth first; cache their normal angles. */
+  void
+  orderPoints(const pcl::octree::OctreeNode* node);
+
+  /** \brief eq. 4-6 over ordered points [begin, end). */
+  NodeStatistics
+  computeStatistics(std::size_t begin, std::size_t end) const;
+
+  /** \brief First and one-past-last ordered point under a node. */
+  std::pair<std::size_t, std::size_t>
+  nodeRange(const pcl::octree::OctreeNode* node) const;
+
+  void
+  splitOrKeep(const pcl::octree::OctreeNode* node,
+              const pcl::octree::OctreeKey& key,
+              std::uint32_t depth,
+              double max_std_dev,
+              std::size_t min_points_to_split);
+
+private:
+  NormalCloudConstPtr normals_;
+  AreasConstPtr areas_;
+  Eigen::Quaternionf sensor_orientation_ = Eigen::Quaternionf::Identity();
+  pcl::Indices ordered_indices_;
+  std::vector<Eigen::Vector3d> ordered_normals_; ///< sensor frame, reversed (eq. 5)
+  std::vector<double> ordered_theta_;            ///< angles of ordered_normals_ [rad]
+  std::vector<double> ordered_phi_;
+  std::vector<double> ordered_areas_;            ///< A_p
+  std::vector<AdaptiveLeaf> leaves_;
+};
+
+} // namespace selective_seg
+} // namespace pcl
+
+// The octree always compiles its bodies, like PCL's own octrees with custom containers.
+#include <pcl_selective_seg/impl/octree_pointcloud_normal_variance.hpp>

@@ -1,0 +1,79 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
+ */
+
+#pragma once
+
+#include <pcl_selective_seg/delaunay_2d.h>
+
+#include <pcl/pcl_macros.h>
+
+#include <string>
+
+namespace pcl {
+namespace selective_seg {
+
+/** \brief Every parameter of SelectiveSegmentation, with the paper's defaults.
+ *
+ * Angles are in radians, lengths in metres (the cloud's unit). docs/parameters.md gives
+ * each parameter's meaning, default, valid range and the stage that reads it.
+ */
+struct PCL_EXPORTS SelectiveSegmentationParameters {
+  /** \brief Octree split threshold on the weighted standard deviation of the normal
+   * angles (eq. 5), per axis [rad]. Paper: 7.6 degrees. Valid: (0, pi]. */
+  double max_normal_std_dev = 7.6 * M_PI / 180.0;
+
+  /** \brief Maximum angle between two segment normals for them to merge (eq. 9)
+   * [rad]. Paper: 25 degrees. Valid: [0, pi]. */
+  double max_merge_angle = 25.0 * M_PI / 180.0;
+
+  /** \brief Maximum angle between an edge triangle's normal and the growing segment's
+   * normal for the triangle to be searched for neighbours (eq. 8) [rad]. Paper: 25
+   * degrees. Valid: [0, pi]. */
+  double max_edge_triangle_angle = 25.0 * M_PI / 180.0;
+
+  /** \brief Largest angle between an edge triangle's normal and the line of sight to
+   * it for the triangle to count as surface [rad]. A triangle seen more obliquely
+   * spans a depth discontinuity (the "veil" between an occluding edge and the surface
+   * behind it) and is never a valid edge triangle, whatever its normal. pi/2 disables
+   * the test, which is the paper's literal reading. Default 85 degrees: an addition to
+   * the paper, measured in docs/parameters.md. Valid: (0, pi/2]. */
+  double max_view_incidence_angle = 85.0 * M_PI / 180.0;
+
+  /** \brief Smallest octree voxel edge [m]; voxels of this size are never split.
+   * 0 = automatic: min_voxel_size_factor times the median 3-D edge length of the
+   * Delaunay mesh (the median point spacing). Valid: 0 or a positive finite value. */
+  double min_voxel_size = 0.0;
+
+  /** \brief Automatic minimum voxel size in units of the median point spacing
+   * (used when min_voxel_size is 0). Valid: [0.5, 1000]. */
+  double min_voxel_size_factor = 2.0;
+
+  /** \brief A voxel holding fewer points than this is never split. Valid: >= 2. */
+  int min_points_to_split = 8;
+
+  /** \brief Deepest octree level; bounds the tree for clouds of extreme extent, where
+   * the effective minimum voxel size grows to extent / 2^max_octree_depth.
+   * Valid: [1, 21]. */
+  int max_octree_depth = 16;
+
+  /** \brief Grid step on which the (theta, phi) angles are quantized for the exact
+   * triangulation [rad]. Points falling on one grid position share one mesh vertex.
+   * Default 1e-7 rad (0.1 micrometre at 1 m). Valid: [2.5e-8, 1e-2]. */
+  double angle_quantization = 1e-7;
+
+  /** \brief Triangulation backend. */
+  DelaunayBackend delaunay_backend = DelaunayBackend::BoostVoronoi;
+
+  /** \brief Check every parameter.
+   * \param[out] why when invalid and non-null: which parameter, its value and its
+   *             valid range.
+   * \return true when all parameters are valid. */
+  bool
+  validate(std::string* why = nullptr) const;
+};
+
+} // namespace selective_seg
+} // namespace pcl

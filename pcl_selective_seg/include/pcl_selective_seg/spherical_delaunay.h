@@ -1,0 +1,172 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
+ */
+
+#pragma once
+
+#include <pcl_selective_seg/delaunay_2d.h>
+
+#include <Eigen/Geometry>
+#include <pcl/surface/reconstruction.h>
+
+#include <vector>
+
+namespace pcl {
+namespace selective_seg {
+
+/** \brief Why a point has no mesh vertex (values of SphericalTriangulation::point_vertex). */
+enum PointStatus : pcl::index_t {
+  kOutsideIndices = -1, ///< not in the indices
+  kNonFinite = -2,      ///< NaN or Inf coordinate
+  kBehindSensor = -3    ///< z <= 0 in the sensor frame
+};
+
+/** \brief The triangulation of a cloud in spherical space (paper, eq. 1 and Sec. III.A).
+ *
+ * Mesh vertices are the distinct quantized angle pairs, numbered in increasing
+ * (theta, phi) order, so the numbering depends on the point set only. */
+struct SphericalTriangulation {
+  /** #N per input point: its vertex id, or a negative PointStatus. */
+  std::vector<pcl::index_t> point_vertex;
+  /** #V the input point that represents each vertex: among the points sharing its
+   * angles, the nearest to the sensor (ties: smallest x, y, z). */
+  pcl::Indices vertex_point;
+  /** #V quantized (theta, phi) of each vertex: angle / angle_quantization, rounded. */
+  std::vector<QuantizedPoint> vertex_angles;
+  /** #V position of each vertex's representative point in the sensor frame [m]. */
+  std::vector<Eigen::Vector3f> vertex_positions;
+  /** #T triangles over vertex ids, counter-clockwise in (theta, phi). */
+  std::vector<Triangle> triangles;
+  /** #T triangle across the edge opposite each vertex, -1 on the boundary. */
+  std::vector<Triangle> neighbours;
+  std::size_t num_outside_indices = 0;
+  std::size_t num_non_finite = 0;
+  std::size_t num_behind_sensor = 0;
+  double angle_quantization = 0.0; ///< [rad]
+};
+
+/** \brief Delaunay triangulation of a cloud in the sensor's spherical space (theta, phi).
+ *
+ * Points are mapped to the sensor frame (the cloud's sensor_origin_ and
+ * sensor_orientation_ unless setSensorPose() overrides them), then to theta =
+ * atan2(x, z), phi = atan2(y, z) (eq. 1), quantized on a fine grid and triangulated
+ * exactly in that plane. The resulting mesh over the input points keeps the sensor's
+ * view: occluded surfaces do not interleave with occluding ones.
+ *
+ * Points that are not finite or lie at or behind the sensor plane (z <= 0) get no
+ * vertex. Points with equal quantized angles share one vertex.
+ *
+ * Use it as any pcl::MeshConstruction: reconstruct(pcl::PolygonMesh&) gives the mesh over
+ * the input cloud; getTriangulation() the vertex map and triangle adjacency.
+ */
+template <typename PointT>
+class SphericalDelaunay : public pcl::MeshConstruction<PointT> {
+public:
+  using Ptr = pcl::shared_ptr<SphericalDelaunay<PointT>>;
+  using ConstPtr = pcl::shared_ptr<const SphericalDelaunay<PointT>>;
+  using PointCloudConstPtr = typename pcl::PointCloud<PointT>::ConstPtr;
+  using pcl::MeshConstruction<PointT>::reconstruct;
+
+  SphericalDelaunay() { this->check_tree_ = false; }
+
+  /** \brief Triangulation backend (default: DelaunayBackend::BoostVoronoi). */
+  void
+  setBackend(DelaunayBackend backend)
+  {
+    backend_ = backend;
+  }
+  DelaunayBackend
+  getBackend() const
+  {
+    return backend_;
+  }
+
+  /** \brief Grid step of the angle quantization [rad], in [2.5e-8, 1e-2]. */
+  void
+  setAngleQuantization(double step)
+  {
+    angle_quantization_ = step;
+  }
+  double
+  getAngleQuantization() const
+  {
+    return angle_quantization_;
+  }
+
+  /** \brief Sensor pose in the cloud frame, overriding the cloud's sensor_origin_ /
+   * sensor_orientation_. The sensor looks along its +z axis. */
+  void
+  setSensorPose(const Eigen::Affine3f& sensor_to_cloud)
+  {
+    sensor_pose_ = sensor_to_cloud;
+    has_sensor_pose_ = true;
+  }
+  /** \brief Use the cloud's own sensor_origin_ / sensor_orientation_ again. */
+  void
+  resetSensorPose()
+  {
+    has_sensor_pose_ = false;
+  }
+  /** \brief The pose in use: the override, or the input cloud's (identity if none). */
+  Eigen::Affine3f
+  getSensorPose() const;
+
+  /** \brief Guarded: the base class dereferences a missing input. */
+  void
+  reconstruct(pcl::PolygonMesh& output) override;
+
+  /** \brief Project, quantize and triangulate; getTriangulation() gives the result.
+   * \return false (with a PCL_ERROR saying why) on a missing input, a bad parameter or
+   *         a backend failure. Fewer than three distinct non-collinear positions is not
+   *         a failure: the result then has no triangle. */
+  bool
+  triangulate();
+
+  /** \brief The triangulation of the last reconstruct() or triangulate() call. */
+  const SphericalTriangulation&
+  getTriangulation() const
+  {
+    return triangulation_;
+  }
+
+protected:
+  std::string
+  getClassName() const override
+  {
+    return "SphericalDelaunay";
+  }
+
+  void
+  performReconstruction(pcl::PolygonMesh& output) override;
+
+  void
+  performReconstruction(std::vector<pcl::Vertices>& polygons) override;
+
+  /** \brief Stage 1: angles of every input point in indices_, and the vertex map. */
+  void
+  projectAndMergeVertices(SphericalTriangulation& result) const;
+
+  /** \brief Triangulate the vertices of triangulation_ (stage 2). */
+  bool
+  triangulateVertices();
+
+  /** \brief The triangles as polygons over input point indices. */
+  void
+  toPolygons(std::vector<pcl::Vertices>& polygons) const;
+
+private:
+  DelaunayBackend backend_ = DelaunayBackend::BoostVoronoi;
+  double angle_quantization_ = 1e-7;
+  Eigen::Affine3f sensor_pose_ = Eigen::Affine3f::Identity();
+  bool has_sensor_pose_ = false;
+  SphericalTriangulation triangulation_;
+};
+
+} // namespace selective_seg
+} // namespace pcl
+
+#ifdef PCL_NO_PRECOMPILE
+#include <pcl_selective_seg/impl/spherical_delaunay.hpp>
+#endif

@@ -1,0 +1,92 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
+ */
+
+/* Internal header: the Delaunay backends behind delaunay2d() and the exact integer
+ * predicates they share. Not installed. */
+
+#pragma once
+
+#include <pcl_selective_seg/delaunay_2d.h>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace pcl {
+namespace selective_seg {
+namespace detail {
+
+/** \brief Signed 128-bit integer (a GCC/Clang extension, hence the marker). */
+__extension__ typedef __int128 Int128;
+
+/** \brief Twice the signed area of triangle (a, b, c): positive if counter-clockwise.
+ *
+ * Exact for |coordinate| <= kMaxDelaunayCoordinate = 2^26: every difference is at most
+ * 2^27 in magnitude, each product at most 2^54 and the result at most 2^55 < 2^63.
+ */
+inline std::int64_t
+orientation(const QuantizedPoint& a, const QuantizedPoint& b, const QuantizedPoint& c)
+{
+  const std::int64_t abx = std::int64_t{b[0]} - a[0];
+  const std::int64_t aby = std::int64_t{b[1]} - a[1];
+  const std::int64_t acx = std::int64_t{c[0]} - a[0];
+  const std::int64_t acy = std::int64_t{c[1]} - a[1];
+  return abx * acy - aby * acx;
+}
+
+/** \brief In-circle determinant: positive if d lies strictly inside the circumcircle of
+ * the counter-clockwise triangle (a, b, c), zero if the four points are co-circular.
+ *
+ * Exact for |coordinate| <= 2^26. With differences to d of magnitude <= 2^27, each
+ * lifted term dx^2 + dy^2 is <= 2^55 and each 2x2 minor dx1 * dy2 - dx2 * dy1 is
+ * <= 2^55, both fitting in int64. Each of the three products is <= 2^110, so the
+ * determinant is <= 3 * 2^110 < 2^112, far inside the int128 range (2^127).
+ */
+inline Int128
+inCircle(const QuantizedPoint& a,
+         const QuantizedPoint& b,
+         const QuantizedPoint& c,
+         const QuantizedPoint& d)
+{
+  const std::int64_t adx = std::int64_t{a[0]} - d[0];
+  const std::int64_t ady = std::int64_t{a[1]} - d[1];
+  const std::int64_t bdx = std::int64_t{b[0]} - d[0];
+  const std::int64_t bdy = std::int64_t{b[1]} - d[1];
+  const std::int64_t cdx = std::int64_t{c[0]} - d[0];
+  const std::int64_t cdy = std::int64_t{c[1]} - d[1];
+  const std::int64_t a_lift = adx * adx + ady * ady;
+  const std::int64_t b_lift = bdx * bdx + bdy * bdy;
+  const std::int64_t c_lift = cdx * cdx + cdy * cdy;
+  return Int128{a_lift} * (bdx * cdy - cdx * bdy) +
+         Int128{b_lift} * (cdx * ady - adx * cdy) +
+         Int128{c_lift} * (adx * bdy - bdx * ady);
+}
+
+/** \brief Exact Delaunay triangulation through the dual of Boost.Polygon's Voronoi
+ * diagram, co-circular polygons split by the canonical fan rule.
+ *
+ * Expects distinct points within range (delaunay2d() checks). The triangles are
+ * counter-clockwise but not in canonical order. Returns false, with a message, only if
+ * the Voronoi diagram cannot be turned into a triangulation (an internal error).
+ */
+bool
+delaunayBoostVoronoi(const std::vector<QuantizedPoint>& points,
+                     std::vector<Triangle>& triangles,
+                     std::string* error);
+
+/** \brief Triangulation by vtkDelaunay2D (floating point), triangles oriented counter-
+ * clockwise by the exact orientation, degenerate ones dropped, not in canonical order.
+ *
+ * Defined only when the library is built with VTK (PCL_SELSEG_HAVE_VTK).
+ */
+bool
+delaunayVtk(const std::vector<QuantizedPoint>& points,
+            std::vector<Triangle>& triangles,
+            std::string* error);
+
+} // namespace detail
+} // namespace selective_seg
+} // namespace pcl

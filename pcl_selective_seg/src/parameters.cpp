@@ -1,0 +1,68 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
+ */
+
+#include <pcl_selective_seg/parameters.h>
+
+#include <cmath>
+#include <sstream>
+
+namespace pcl {
+namespace selective_seg {
+namespace {
+
+bool
+reject(std::string* why, const char* name, double value, const char* range)
+{
+  if (why) {
+    std::ostringstream s;
+    s << "parameter " << name << " = " << value << " is invalid: valid range " << range;
+    *why = s.str();
+  }
+  return false;
+}
+
+bool
+inRange(double v, double lo, double hi)
+{
+  return std::isfinite(v) && v >= lo && v <= hi;
+}
+
+} // namespace
+
+bool
+SelectiveSegmentationParameters::validate(std::string* why) const
+{
+  if (!inRange(max_normal_std_dev, 0.0, M_PI) || max_normal_std_dev == 0.0)
+    return reject(why, "max_normal_std_dev [rad]", max_normal_std_dev, "(0, pi]");
+  if (!inRange(max_merge_angle, 0.0, M_PI))
+    return reject(why, "max_merge_angle [rad]", max_merge_angle, "[0, pi]");
+  if (!inRange(max_edge_triangle_angle, 0.0, M_PI))
+    return reject(why, "max_edge_triangle_angle [rad]", max_edge_triangle_angle, "[0, pi]");
+  if (!inRange(max_view_incidence_angle, 0.0, M_PI / 2.0) ||
+      max_view_incidence_angle == 0.0)
+    return reject(
+        why, "max_view_incidence_angle [rad]", max_view_incidence_angle, "(0, pi/2]");
+  if (!std::isfinite(min_voxel_size) || min_voxel_size < 0.0)
+    return reject(why, "min_voxel_size [m]", min_voxel_size, "0 (automatic) or > 0");
+  if (!inRange(min_voxel_size_factor, 0.5, 1000.0))
+    return reject(why, "min_voxel_size_factor", min_voxel_size_factor, "[0.5, 1000]");
+  if (min_points_to_split < 2)
+    return reject(why, "min_points_to_split", min_points_to_split, ">= 2");
+  if (max_octree_depth < 1 || max_octree_depth > 21)
+    return reject(why, "max_octree_depth", max_octree_depth, "[1, 21]");
+  if (!inRange(angle_quantization, 2.5e-8, 1e-2))
+    return reject(why, "angle_quantization [rad]", angle_quantization, "[2.5e-8, 1e-2]");
+  if (!isDelaunayBackendAvailable(delaunay_backend)) {
+    if (why)
+      *why = std::string("parameter delaunay_backend = ") + toString(delaunay_backend) +
+             " is not available in this build (the library was built without VTK)";
+    return false;
+  }
+  return true;
+}
+
+} // namespace selective_seg
+} // namespace pcl

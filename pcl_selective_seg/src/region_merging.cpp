@@ -1,0 +1,224 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
+ */
+
+#include <pcl_selective_seg/region_merging.h>
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <numeric>
+
+namespace pcl {
+namespace selective_seg {
+
+Incidence
+Incidence::build(const std::vector<pcl::index_t>& group_of, std::size_t num_groups)
+{
+  Incidence inc;
+  inc.offsets.assign(num_groups + 1, 0);
+  for (const auto g : group_of)
+    if (g >= 0)
+      ++inc.offsets[static_cast<std::size_t>(g) + 1];
+  std::partial_sum(inc.offsets.begin(), inc.offsets.end(), inc.offsets.begin());
+  inc.items.resize(inc.offsets.back());
+  std::vector<std::size_t> next(inc.offsets.begin(), inc.offsets.end() - 1);
+  for (std::size_t i = 0; i < group_of.size(); ++i)
+    if (group_of[i] >= 0)
+      inc.items[next[static_cast<std::size_t>(group_of[i])]++] =
+          static_cast<pcl::index_t>(i);
+  return inc;
+}
+
+Incidence
+vertexTriangles(const std::vector<Triangle>& triangles, std::size_t num_vertices)
+{
+  Incidence inc;
+  inc.offsets.assign(num_vertices + 1, 0);
+  for (const auto& t : triangles)
+    for (const auto v : t)
+      ++inc.offsets[static_cast<std::size_t>(v) + 1];
+  std::partial_sum(inc.offsets.begin(), inc.offsets.end(), inc.offsets.begin());
+  inc.items.resize(inc.offsets.back());
+  std::vector<std::size_t> next(inc.offsets.begin(), inc.offsets.end() - 1);
+  for (std::size_t t = 0; t < triangles.size(); ++t)
+    for (const auto v : triangles[t])
+      inc.items[next[static_cast<std::size_t>(v)]++] = static_cast<pcl::index_t>(t);
+  return inc;
+}
+
+namespace {
+
+/** A segment while it grows: eq. 7 as a running sum. */
+struct GrowingSegment {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+
+  void
+  add(const Eigen::Vector3f& leaf_normal, double leaf_area)
+  {
+    if (leaf_area > 0.0 && std::isfinite(leaf_area))
+      sum += leaf_normal.cast<double>() / leaf_area;
+    const double norm = sum.norm();
+    if (norm > 0.0 && std::isfinite(norm))
+      normal = sum / norm;
+  }
+};
+
+/** Seeds, largest first; ties by leaf index. */
+std::vector<pcl::index_t>
+seedOrder(const Incidence& leaf_vertices)
+{
+  const std::size_t num_leaves = leaf_vertices.offsets.size() - 1;
+  std::vector<pcl::index_t> order(num_leaves);
+  std::iota(order.begin(), order.end(), 0);
+  const auto size = [&](pcl::index_t l) {
+    return leaf_vertices.offsets[l + 1] - leaf_vertices.offsets[l];
+  };
+  std::stable_sort(order.begin(), order.end(), [&](pcl::index_t a, pcl::index_t b) {
+    return size(a) > size(b);
+  });
+  return order;
+}
+
+class SeedMerger {
+public:
+  explicit SeedMerger(const MergeInput& in)
+  : in_(in)
+  , leaf_vertices_(Incidence::build(*in.vertex_leaf, in.leaf_normals->size()))
+  , vertex_triangles_(vertexTriangles(*in.triangles, in.vertex_leaf->size()))
+  , cos_merge_(std::cos(in.max_merge_angle))
+  , cos_edge_(std::cos(in.max_edge_triangle_angle))
+  {}
+
+  void
+  run(std::vector<pcl::index_t>& leaf_segment, Vector3fVector& segment_normals)
+  {
+    leaf_segment.assign(in_.leaf_normals->size(), -1);
+    segment_normals.clear();
+    for (const auto seed : seedOrder(leaf_vertices_)) {
+      if (leaf_segment[seed] >= 0)
+        continue;
+      const auto k = static_cast<pcl::index_t>(segment_normals.size());
+      segment_normals.push_back(grow(seed, k, leaf_segment).cast<float>());
+    }
+  }
+
+private:
+  Eigen::Vector3d
+  grow(pcl::index_t seed, pcl::index_t k, std::vector<pcl::index_t>& leaf_segment)
+  {
+    GrowingSegment segment;
+    segment.add((*in_.leaf_normals)[seed], (*in_.leaf_areas)[seed]);
+    leaf_segment[seed] = k;
+    std::deque<pcl::index_t> queue{seed};
+    while (!queue.empty()) {
+      const auto leaf = queue.front();
+      queue.pop_front();
+      for (auto i = leaf_vertices_.offsets[leaf]; i < leaf_vertices_.offsets[leaf + 1]; ++i)
+        visitVertex(leaf_vertices_.items[i], k, segment, leaf_segment, queue);
+    }
+    return segment.normal;
+  }
+
+  void
+  visitVertex(pcl::index_t vertex,
+              pcl::index_t k,
+              GrowingSegment& segment,
+              std::vector<pcl::index_t>& leaf_segment,
+              std::deque<pcl::index_t>& queue)
+  {
+    const auto& vertex_leaf = *in_.vertex_leaf;
+    for (auto i = vertex_triangles_.offsets[vertex];
+         i < vertex_triangles_.offsets[vertex + 1];
+         ++i) {
+      const auto t = vertex_triangles_.items[i];
+      const Triangle& tri = (*in_.triangles)[t];
+      const bool edge = std::any_of(tri.begin(), tri.end(), [&](pcl::index_t v) {
+        return vertex_leaf[v] >= 0 && leaf_segment[vertex_leaf[v]] != k;
+      });
+      if (!edge || !isValidFor(t, segment.normal))
+        continue; // interior, or an invalid edge triangle (eq. 8)
+      for (const auto v : tri) {
+        const auto other = vertex_leaf[v];
+        if (other < 0 || leaf_segment[other] >= 0)
+          continue;
+        const Eigen::Vector3f& n_other = (*in_.leaf_normals)[other];
+        if (n_other.cast<double>().dot(segment.normal) < cos_merge_)
+          continue; // eq. 9
+        leaf_segment[other] = k; // eq. 10
+        segment.add(n_other, (*in_.leaf_areas)[other]);
+        queue.push_back(other);
+      }
+    }
+  }
+
+  bool
+  isValidFor(pcl::index_t t, const Eigen::Vector3d& segment_normal) const
+  {
+    const Eigen::Vector3f& n_t = (*in_.triangle_normals)[t];
+    if (!n_t.allFinite() || (in_.triangle_edge_on && (*in_.triangle_edge_on)[t]))
+      return false;
+    return n_t.cast<double>().dot(segment_normal) >= cos_edge_;
+  }
+
+  const MergeInput& in_;
+  Incidence leaf_vertices_;
+  Incidence vertex_triangles_;
+  double cos_merge_;
+  double cos_edge_;
+};
+
+} // namespace
+
+void
+mergeSeedSegments(const MergeInput& input,
+                  std::vector<pcl::index_t>& leaf_segment,
+                  Vector3fVector& segment_normals)
+{
+  SeedMerger(input).run(leaf_segment, segment_normals);
+}
+
+void
+classifyTriangles(const std::vector<Triangle>& triangles,
+                  const Vector3fVector& triangle_normals,
+                  const std::vector<std::uint8_t>* triangle_edge_on,
+                  const std::vector<std::uint32_t>& vertex_labels,
+                  const Vector3fVector& label_normals,
+                  double max_edge_triangle_angle,
+                  std::vector<std::uint32_t>& labels,
+                  std::vector<TriangleClass>& classes)
+{
+  const double cos_edge = std::cos(max_edge_triangle_angle);
+  labels.assign(triangles.size(), 0);
+  classes.assign(triangles.size(), TriangleClass::InvalidEdge);
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    const auto& tri = triangles[t];
+    const std::uint32_t l0 = vertex_labels[tri[0]];
+    if (l0 != 0 && l0 == vertex_labels[tri[1]] && l0 == vertex_labels[tri[2]]) {
+      labels[t] = l0;
+      classes[t] = TriangleClass::Interior;
+      continue;
+    }
+    const Eigen::Vector3f& n = triangle_normals[t];
+    double best = -2.0;
+    for (const auto v : tri) {
+      const std::uint32_t l = vertex_labels[v];
+      if (l == 0)
+        continue;
+      const double c = n.allFinite() ? n.dot(label_normals[l - 1]) : -1.5;
+      if (c > best || (c == best && l < labels[t])) {
+        best = c;
+        labels[t] = l;
+      }
+    }
+    const bool edge_on = triangle_edge_on && (*triangle_edge_on)[t];
+    if (labels[t] != 0 && best >= cos_edge && !edge_on)
+      classes[t] = TriangleClass::ValidEdge;
+  }
+}
+
+} // namespace selective_seg
+} // namespace pcl

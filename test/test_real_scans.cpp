@@ -1,0 +1,116 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
+ */
+
+// Real scans: the mOSD RGB-D frames with object-part ground truth, and PCL's stereo mug
+// scene. The data folder is the first argument; the tests skip when it is missing.
+
+#include <pcl_selective_seg/selective_segmentation.h>
+
+#include <gtest/gtest.h>
+#include <pcl/io/pcd_io.h>
+
+#include <map>
+#include <string>
+
+namespace {
+
+std::string data_dir; // NOLINT: set once in main()
+
+bool
+load(const std::string& relative, pcl::PointCloud<pcl::PointXYZL>& cloud)
+{
+  return !data_dir.empty() &&
+         pcl::io::loadPCDFile(data_dir + "/" + relative, cloud) == 0 && !cloud.empty();
+}
+
+/** Fraction of the labeled points that lie in a segment whose majority ground-truth
+ * label is not theirs (ground-truth 0, invalid, ignored). */
+double
+leakage(const pcl::PointCloud<pcl::PointXYZL>& truth,
+        const std::vector<pcl::PointIndices>& segments)
+{
+  std::size_t leaked = 0, total = 0;
+  for (const auto& s : segments) {
+    std::map<std::uint32_t, std::size_t> votes;
+    for (const auto i : s.indices)
+      if (truth[i].label != 0)
+        ++votes[truth[i].label];
+    std::size_t in_segment = 0, majority = 0;
+    for (const auto& v : votes) {
+      in_segment += v.second;
+      majority = std::max(majority, v.second);
+    }
+    leaked += in_segment - majority;
+    total += in_segment;
+  }
+  return total ? static_cast<double>(leaked) / total : 0.0;
+}
+
+} // namespace
+
+class MosdFrame : public ::testing::TestWithParam<const char*> {};
+
+// The mOSD labels are object parts (a box is one label), so splitting a box into faces is
+// expected; merging a box with the table is not. Measured with the default parameters:
+// learn0 0.14%, learn17 0.18%, test0 0.09% of the points leak; asserted below 0.5%.
+TEST_P(MosdFrame, SegmentsDoNotLeakAcrossObjects)
+{
+  auto cloud = pcl::make_shared<pcl::PointCloud<pcl::PointXYZL>>();
+  if (!load(std::string("mosd/") + GetParam() + ".pcd", *cloud))
+    GTEST_SKIP() << "mOSD frame not found under '" << data_dir << "'";
+  pcl::selective_seg::SelectiveSegmentation<pcl::PointXYZL> seg;
+  seg.setInputCloud(cloud);
+  std::vector<pcl::PointIndices> segments;
+  ASSERT_TRUE(seg.extract(segments));
+  const auto& r = seg.getResult();
+  EXPECT_EQ(r.labels.size(), cloud->size());
+  EXPECT_GT(r.counts.labeled, 150000u);
+  EXPECT_EQ(r.counts.non_finite + r.counts.labeled + r.counts.without_normal +
+                r.counts.behind_sensor,
+            cloud->size());
+  EXPECT_LT(leakage(*cloud, segments), 0.005);
+  // The table top is the largest segment and almost all table.
+  std::size_t table = 0;
+  for (const auto i : segments[0].indices)
+    table += (*cloud)[i].label >= 1 && (*cloud)[i].label <= 9;
+  EXPECT_GT(table, 0.99 * segments[0].indices.size());
+}
+
+INSTANTIATE_TEST_SUITE_P(RealScans,
+                         MosdFrame,
+                         ::testing::Values("learn0", "learn17", "test0"));
+
+TEST(StereoScan, MugSceneSegments)
+{
+  auto cloud = pcl::make_shared<pcl::PointCloud<pcl::PointXYZL>>();
+  if (!load("pcl_test/table_scene_mug_stereo_textured.pcd", *cloud))
+    GTEST_SKIP() << "stereo mug scene not found under '" << data_dir << "'";
+  pcl::selective_seg::SelectiveSegmentation<pcl::PointXYZL> seg;
+  seg.setInputCloud(cloud);
+  // The file's VIEWPOINT says the sensor is turned 180 degrees about x, which would put
+  // every point behind it; the cloud is in fact in the camera frame.
+  std::vector<pcl::PointIndices> none;
+  EXPECT_FALSE(seg.extract(none));
+  EXPECT_EQ(seg.getResult().counts.behind_sensor, 209280u);
+  seg.setSensorPose(Eigen::Affine3f::Identity());
+  std::vector<pcl::PointIndices> segments;
+  ASSERT_TRUE(seg.extract(segments));
+  const auto labeled = seg.getLabeledCloud();
+  EXPECT_EQ(labeled->width, 640u);
+  EXPECT_EQ(labeled->height, 480u);
+  // The table dominates the view.
+  EXPECT_GT(segments[0].indices.size(), 0.4 * seg.getResult().counts.labeled);
+  EXPECT_GT(segments.size(), 10u);
+}
+
+int
+main(int argc, char** argv)
+{
+  testing::InitGoogleTest(&argc, argv);
+  if (argc > 1)
+    data_dir = argv[1];
+  return RUN_ALL_TESTS();
+}

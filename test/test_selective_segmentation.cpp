@@ -1,0 +1,473 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
+ */
+
+// End-to-end tests of SelectiveSegmentation: ground-truth scenes, invariances, bad input
+// and the agreement of the labels, the mesh and the octree.
+
+#include <pcl_selective_seg/point_types.h>
+#include <pcl_selective_seg/selective_segmentation.h>
+#include <synthetic_scenes.h>
+
+#include <boost/preprocessor/seq/enum.hpp>
+#include <gtest/gtest.h>
+#include <pcl/common/transforms.h>
+
+#include <algorithm>
+#include <limits>
+#include <map>
+#include <numeric>
+#include <random>
+#include <set>
+
+using pcl::selective_seg::SelectiveSegmentation;
+using Labeled = pcl::PointCloud<pcl::PointXYZL>;
+
+namespace {
+
+Labeled::Ptr
+cubeScene(std::size_t rays, unsigned seed = 42)
+{
+  auto view = selseg_test::makeCubeOnTableView(rays);
+  view.seed = seed;
+  return pcl::make_shared<Labeled>(
+      selseg_test::scan(selseg_test::makeCubeOnTableScene(), view));
+}
+
+template <typename PointT>
+bool
+segment(const typename pcl::PointCloud<PointT>::ConstPtr& cloud,
+        SelectiveSegmentation<PointT>& seg,
+        std::vector<pcl::PointIndices>& clusters)
+{
+  seg.setInputCloud(cloud);
+  return seg.extract(clusters);
+}
+
+/** Ground-truth label -> (segment label -> points). */
+std::map<std::uint32_t, std::map<std::uint32_t, std::size_t>>
+overlap(const Labeled& truth, const std::vector<std::uint32_t>& labels)
+{
+  std::map<std::uint32_t, std::map<std::uint32_t, std::size_t>> table;
+  for (std::size_t i = 0; i < truth.size(); ++i)
+    ++table[truth[i].label][labels[i]];
+  return table;
+}
+
+/** A regular grid of points on the plane z = depth, seen from the origin. */
+pcl::PointCloud<pcl::PointXYZ>::Ptr
+wall(int w, int h, float depth = 2.0f)
+{
+  auto cloud = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>(w, h);
+  for (int r = 0; r < h; ++r)
+    for (int c = 0; c < w; ++c)
+      cloud->at(c, r) = pcl::PointXYZ(0.02f * (c - w / 2), 0.02f * (r - h / 2), depth);
+  return cloud;
+}
+
+} // namespace
+
+// The paper's Fig. 7: a cube on a table in front of a wall, irregular sampling whose
+// density varies tenfold. Every visible face and background plane is one segment.
+TEST(SelectiveSegmentation, CubeSceneGivesOneSegmentPerFace)
+{
+  for (const unsigned seed : {1u, 2u, 3u}) {
+    const auto truth = cubeScene(5432, seed);
+    SelectiveSegmentation<pcl::PointXYZL> seg;
+    std::vector<pcl::PointIndices> clusters;
+    ASSERT_TRUE(segment<pcl::PointXYZL>(truth, seg, clusters));
+    const auto& labels = seg.getResult().labels;
+    const auto table = overlap(*truth, labels);
+    ASSERT_EQ(table.size(), 5u); // wall, table, three cube faces
+    std::set<std::uint32_t> used;
+    for (const auto& [face, segments] : table) {
+      const auto best = std::max_element(
+          segments.begin(), segments.end(), [](const auto& a, const auto& b) {
+            return a.second < b.second;
+          });
+      std::size_t face_points = 0;
+      for (const auto& s : segments)
+        face_points += s.second;
+      // One segment covers the face (the rest: small edge segments along its border).
+      EXPECT_GT(best->second, 0.85 * face_points) << "face " << face << " seed " << seed;
+      EXPECT_TRUE(used.insert(best->first).second) << "two faces share segment "
+                                                   << best->first;
+      // ... and it is pure: at most 5% of its points come from other faces.
+      const std::size_t size = clusters[best->first - 1].indices.size();
+      EXPECT_LT(size - best->second, 0.05 * size) << "face " << face << " seed " << seed;
+    }
+  }
+}
+
+// The literal paper (no edge-on test) lets the cube top merge with the parallel table
+// through the triangles that span the depth jump behind the cube.
+TEST(SelectiveSegmentation, EdgeOnTrianglesJoinParallelPlanesWhenNotExcluded)
+{
+  const auto truth = cubeScene(5432, 1);
+  SelectiveSegmentation<pcl::PointXYZL> seg;
+  seg.setMaxViewIncidenceAngle(M_PI / 2.0);
+  std::vector<pcl::PointIndices> clusters;
+  ASSERT_TRUE(segment<pcl::PointXYZL>(truth, seg, clusters));
+  const auto table = overlap(*truth, seg.getResult().labels);
+  const auto dominant = [&](std::uint32_t face) {
+    return std::max_element(table.at(face).begin(),
+                            table.at(face).end(),
+                            [](const auto& a, const auto& b) { return a.second < b.second; })
+        ->first;
+  };
+  EXPECT_EQ(dominant(2), dominant(3)); // table and cube top: one segment
+}
+
+TEST(SelectiveSegmentation, ShuffledInputGivesIdenticalSegments)
+{
+  const auto cloud = cubeScene(20000, 7);
+  std::vector<int> perm(cloud->size());
+  std::iota(perm.begin(), perm.end(), 0);
+  std::shuffle(perm.begin(), perm.end(), std::mt19937(42));
+  auto shuffled = pcl::make_shared<Labeled>();
+  for (const int i : perm)
+    shuffled->push_back((*cloud)[i]);
+
+  SelectiveSegmentation<pcl::PointXYZL> a, b;
+  std::vector<pcl::PointIndices> ca, cb;
+  ASSERT_TRUE(segment<pcl::PointXYZL>(cloud, a, ca));
+  ASSERT_TRUE(segment<pcl::PointXYZL>(shuffled, b, cb));
+  ASSERT_EQ(ca.size(), cb.size());
+  // Labels are ranked by a data-only order, so they are equal, not only equivalent.
+  for (std::size_t k = 0; k < perm.size(); ++k)
+    ASSERT_EQ(a.getResult().labels[perm[k]], b.getResult().labels[k]) << k;
+  EXPECT_EQ(a.getResult().leaves.size(), b.getResult().leaves.size());
+}
+
+TEST(SelectiveSegmentation, LabelsMeshAndOctreeAgree)
+{
+  const auto cloud = cubeScene(20000, 3);
+  SelectiveSegmentation<pcl::PointXYZL> seg;
+  std::vector<pcl::PointIndices> clusters;
+  ASSERT_TRUE(segment<pcl::PointXYZL>(cloud, seg, clusters));
+  const auto& r = seg.getResult();
+
+  // Counts: every point in exactly one category.
+  const auto& c = r.counts;
+  EXPECT_EQ(c.outside_indices + c.non_finite + c.behind_sensor + c.without_normal +
+                c.labeled,
+            cloud->size());
+  // Clusters: largest first, segment i holds label i + 1.
+  ASSERT_EQ(clusters.size(), r.segments.size());
+  std::size_t labeled = 0;
+  for (std::size_t s = 0; s < clusters.size(); ++s) {
+    if (s > 0)
+      EXPECT_LE(clusters[s].indices.size(), clusters[s - 1].indices.size());
+    EXPECT_EQ(clusters[s].indices.size(), r.segments[s].num_points);
+    for (const auto i : clusters[s].indices)
+      EXPECT_EQ(r.labels[i], s + 1);
+    labeled += clusters[s].indices.size();
+  }
+  EXPECT_EQ(labeled, c.labeled);
+  // Octree (over the vertices): each leaf's points carry the leaf's label and lie in
+  // its voxel; the leaves cover the vertices. The sensor frame is the cloud frame here.
+  const auto& ordered = seg.getOctree()->getOrderedIndices();
+  const auto& vertex_point = seg.getTriangulation().vertex_point;
+  const auto& leaves = seg.getOctree()->getAdaptiveLeaves();
+  ASSERT_EQ(leaves.size(), r.leaves.size());
+  std::size_t in_leaves = 0;
+  for (std::size_t l = 0; l < leaves.size(); ++l) {
+    const float half = 0.5f * r.leaves[l].size * 1.0001f;
+    for (std::size_t k = leaves[l].begin; k < leaves[l].end; ++k) {
+      const auto point = vertex_point[ordered[k]];
+      EXPECT_EQ(r.labels[point], r.leaves[l].label);
+      const Eigen::Vector3f d = (*cloud)[point].getVector3fMap() - r.leaves[l].centre;
+      EXPECT_LE(d.cwiseAbs().maxCoeff(), half);
+    }
+    in_leaves += r.leaves[l].num_points;
+  }
+  EXPECT_EQ(in_leaves, r.num_vertices);
+  // Mesh: interior triangles carry their vertices' label; edge ones one of theirs.
+  using pcl::selective_seg::TriangleClass;
+  for (std::size_t t = 0; t < r.mesh.triangles.size(); ++t) {
+    const auto& tri = r.mesh.triangles[t];
+    const std::set<std::uint32_t> vl{r.labels[tri[0]], r.labels[tri[1]], r.labels[tri[2]]};
+    if (r.mesh.classes[t] == TriangleClass::Interior)
+      EXPECT_EQ(vl, std::set<std::uint32_t>{r.mesh.labels[t]});
+    else
+      EXPECT_TRUE(vl.size() > 1 && vl.count(r.mesh.labels[t]));
+  }
+  // Normals: unit, toward the sensor, on every labeled point.
+  const auto normals = seg.getPointNormals();
+  ASSERT_EQ(normals->size(), cloud->size());
+  for (std::size_t i = 0; i < cloud->size(); ++i) {
+    const Eigen::Vector3f n = (*normals)[i].getNormalVector3fMap();
+    ASSERT_NEAR(n.norm(), 1.0f, 1e-4f);
+    EXPECT_LE(n.dot((*cloud)[i].getVector3fMap()), 0.0f);
+  }
+}
+
+TEST(SelectiveSegmentation, WallFacingTheSensorIsOneSegment)
+{
+  const auto cloud = wall(60, 40); // organized 60 x 40: every cell co-circular
+  SelectiveSegmentation<pcl::PointXYZ> seg;
+  std::vector<pcl::PointIndices> clusters;
+  ASSERT_TRUE(segment<pcl::PointXYZ>(cloud, seg, clusters));
+  ASSERT_EQ(clusters.size(), 1u);
+  EXPECT_EQ(clusters[0].indices.size(), cloud->size());
+  EXPECT_NEAR(seg.getResult().segments[0].normal.z(), -1.0f, 1e-5f);
+  EXPECT_EQ(seg.getResult().mesh.triangles.size(), 2u * 59u * 39u);
+  // The organized layout is kept.
+  const auto labeled = seg.getLabeledCloud();
+  EXPECT_EQ(labeled->width, 60u);
+  EXPECT_EQ(labeled->height, 40u);
+}
+
+TEST(SelectiveSegmentation, SensorPoseIsHonoured)
+{
+  const auto cloud = cubeScene(5432, 5);
+  SelectiveSegmentation<pcl::PointXYZL> in_sensor_frame;
+  std::vector<pcl::PointIndices> clusters;
+  ASSERT_TRUE(segment<pcl::PointXYZL>(cloud, in_sensor_frame, clusters));
+
+  // The same scan in a world frame where the sensor sits at (1, 2, 3), rotated.
+  Eigen::Affine3f pose = Eigen::Affine3f::Identity();
+  pose.translate(Eigen::Vector3f(1.0f, 2.0f, 3.0f));
+  pose.rotate(Eigen::AngleAxisf(0.7f, Eigen::Vector3f(0.3f, 1.0f, 0.2f).normalized()));
+  auto world = pcl::make_shared<Labeled>();
+  pcl::transformPointCloud(*cloud, *world, pose);
+  world->sensor_origin_ << pose.translation(), 0.0f;
+  world->sensor_orientation_ = Eigen::Quaternionf(pose.rotation());
+  SelectiveSegmentation<pcl::PointXYZL> from_cloud;
+  ASSERT_TRUE(segment<pcl::PointXYZL>(world, from_cloud, clusters));
+
+  world->sensor_origin_.setZero();
+  world->sensor_orientation_.setIdentity();
+  SelectiveSegmentation<pcl::PointXYZL> from_setter;
+  from_setter.setSensorPose(pose);
+  ASSERT_TRUE(segment<pcl::PointXYZL>(world, from_setter, clusters));
+
+  // Float rounding of the transform may move a point across a quantization step, so
+  // compare the segmentations by agreement rather than bit for bit.
+  const auto agreement = [&](const std::vector<std::uint32_t>& other) {
+    std::size_t same = 0;
+    for (std::size_t i = 0; i < other.size(); ++i)
+      same += other[i] == in_sensor_frame.getResult().labels[i];
+    return static_cast<double>(same) / other.size();
+  };
+  EXPECT_GT(agreement(from_cloud.getResult().labels), 0.98);
+  EXPECT_GT(agreement(from_setter.getResult().labels), 0.98);
+}
+
+TEST(SelectiveSegmentation, IndicesRestrictTheInput)
+{
+  const auto cloud = cubeScene(5432, 6);
+  auto indices = pcl::make_shared<pcl::Indices>();
+  for (pcl::index_t i = 0; i < static_cast<pcl::index_t>(cloud->size()); i += 2)
+    indices->push_back(i);
+  SelectiveSegmentation<pcl::PointXYZL> seg;
+  seg.setInputCloud(cloud);
+  seg.setIndices(indices);
+  std::vector<pcl::PointIndices> clusters;
+  ASSERT_TRUE(seg.extract(clusters));
+  const auto& r = seg.getResult();
+  EXPECT_EQ(r.counts.outside_indices, cloud->size() - indices->size());
+  for (std::size_t i = 1; i < cloud->size(); i += 2)
+    EXPECT_EQ(r.labels[i], 0u);
+  EXPECT_EQ(r.counts.labeled, indices->size());
+}
+
+TEST(SelectiveSegmentation, ExcludedPointsAreCountedAndUnlabeled)
+{
+  auto cloud = wall(30, 30);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  (*cloud)[0].x = nan;
+  (*cloud)[1].z = std::numeric_limits<float>::infinity();
+  (*cloud)[2].z = -1.0f; // behind the sensor
+  (*cloud)[3].z = 0.0f;  // on the sensor plane
+  cloud->is_dense = false;
+  SelectiveSegmentation<pcl::PointXYZ> seg;
+  std::vector<pcl::PointIndices> clusters;
+  ASSERT_TRUE(segment<pcl::PointXYZ>(cloud, seg, clusters));
+  const auto& r = seg.getResult();
+  EXPECT_EQ(r.counts.non_finite, 2u);
+  EXPECT_EQ(r.counts.behind_sensor, 2u);
+  for (int i = 0; i < 4; ++i)
+    EXPECT_EQ(r.labels[i], 0u);
+  EXPECT_EQ(r.counts.labeled, cloud->size() - 4);
+}
+
+TEST(SelectiveSegmentation, DuplicatesShareTheirVertexLabel)
+{
+  auto cloud = wall(20, 20);
+  const std::size_t n = cloud->size();
+  auto doubled = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>(*cloud);
+  for (std::size_t i = 0; i < n; ++i) {
+    doubled->push_back((*cloud)[i]); // exact duplicate
+    pcl::PointXYZ farther = (*cloud)[i];
+    farther.getVector3fMap() *= 1.5f; // same ray, farther away
+    doubled->push_back(farther);
+  }
+  SelectiveSegmentation<pcl::PointXYZ> seg;
+  std::vector<pcl::PointIndices> clusters;
+  ASSERT_TRUE(segment<pcl::PointXYZ>(doubled, seg, clusters));
+  const auto& r = seg.getResult();
+  EXPECT_EQ(r.num_vertices, n);
+  EXPECT_EQ(r.counts.labeled, 3 * n);
+  EXPECT_EQ(r.counts.shared_vertex, 2 * n);
+  for (std::size_t i = 0; i < n; ++i) {
+    EXPECT_EQ(r.labels[n + 2 * i], r.labels[i]);
+    EXPECT_EQ(r.labels[n + 2 * i + 1], r.labels[i]);
+  }
+}
+
+// Bad input: a clear failure (false, empty outputs) or a valid result, never a crash.
+TEST(SelectiveSegmentation, RejectsUnusableInput)
+{
+  using Cloud = pcl::PointCloud<pcl::PointXYZ>;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  std::vector<std::pair<std::string, Cloud::Ptr>> cases;
+  cases.emplace_back("empty", pcl::make_shared<Cloud>());
+  auto one = pcl::make_shared<Cloud>();
+  one->push_back(pcl::PointXYZ(0, 0, 1));
+  cases.emplace_back("one point", one);
+  auto two = pcl::make_shared<Cloud>(*one);
+  two->push_back(pcl::PointXYZ(0.1f, 0, 1));
+  cases.emplace_back("two points", two);
+  auto all_nan = pcl::make_shared<Cloud>();
+  for (int i = 0; i < 100; ++i)
+    all_nan->push_back(pcl::PointXYZ(nan, nan, nan));
+  cases.emplace_back("all NaN", all_nan);
+  auto collinear = pcl::make_shared<Cloud>();
+  for (int i = 0; i < 100; ++i)
+    collinear->push_back(pcl::PointXYZ(0.01f * i, 0.0f, 1.0f + 0.01f * i));
+  cases.emplace_back("collinear", collinear);
+  auto behind = wall(10, 10, -2.0f);
+  cases.emplace_back("behind the sensor", behind);
+  auto same = pcl::make_shared<Cloud>();
+  for (int i = 0; i < 100; ++i)
+    same->push_back(pcl::PointXYZ(0.1f, 0.2f, 1.0f));
+  cases.emplace_back("all identical", same);
+
+  for (const auto& [name, cloud] : cases) {
+    SelectiveSegmentation<pcl::PointXYZ> seg;
+    std::vector<pcl::PointIndices> clusters(3);
+    EXPECT_FALSE(segment<pcl::PointXYZ>(cloud, seg, clusters)) << name;
+    EXPECT_TRUE(clusters.empty()) << name;
+    EXPECT_FALSE(seg.getLabeledCloud()) << name;
+  }
+  SelectiveSegmentation<pcl::PointXYZ> no_input;
+  std::vector<pcl::PointIndices> clusters;
+  EXPECT_FALSE(no_input.extract(clusters));
+}
+
+TEST(SelectiveSegmentation, RejectsBadParametersAndIndices)
+{
+  const auto cloud = wall(10, 10);
+  const auto fails = [&](const pcl::selective_seg::SelectiveSegmentationParameters& p) {
+    SelectiveSegmentation<pcl::PointXYZ> seg;
+    seg.setParameters(p);
+    std::vector<pcl::PointIndices> clusters;
+    return !segment<pcl::PointXYZ>(cloud, seg, clusters) && clusters.empty();
+  };
+  pcl::selective_seg::SelectiveSegmentationParameters p;
+  p.max_normal_std_dev = 0.0;
+  EXPECT_TRUE(fails(p));
+  p = {};
+  p.max_merge_angle = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_TRUE(fails(p));
+  p = {};
+  p.min_voxel_size = -1.0;
+  EXPECT_TRUE(fails(p));
+  p = {};
+  p.angle_quantization = 1.0;
+  EXPECT_TRUE(fails(p));
+  p = {};
+  p.min_points_to_split = 1;
+  EXPECT_TRUE(fails(p));
+
+  SelectiveSegmentation<pcl::PointXYZ> seg;
+  seg.setInputCloud(cloud);
+  seg.setIndices(pcl::make_shared<pcl::Indices>(pcl::Indices{0, 1, 1000}));
+  std::vector<pcl::PointIndices> clusters;
+  EXPECT_FALSE(seg.extract(clusters));
+}
+
+TEST(SelectiveSegmentation, ExtremeCoordinatesDoNotBreakIt)
+{
+  auto huge = wall(20, 20);
+  for (auto& p : *huge)
+    p.getVector3fMap() *= 1e30f;
+  SelectiveSegmentation<pcl::PointXYZ> seg;
+  std::vector<pcl::PointIndices> clusters;
+  ASSERT_TRUE(segment<pcl::PointXYZ>(huge, seg, clusters));
+  ASSERT_EQ(clusters.size(), 1u);
+  EXPECT_EQ(clusters[0].indices.size(), huge->size());
+
+  auto tiny = wall(20, 20);
+  for (auto& p : *tiny)
+    p.getVector3fMap() *= 1e-30f;
+  ASSERT_TRUE(segment<pcl::PointXYZ>(tiny, seg, clusters));
+  EXPECT_EQ(clusters.size(), 1u);
+}
+
+// Every instantiated point type gives the same result on the same coordinates.
+template <typename PointT>
+class SelectiveSegmentationTyped : public ::testing::Test {};
+using PointTypes = ::testing::Types<BOOST_PP_SEQ_ENUM(PCL_SELSEG_POINT_TYPES)>;
+TYPED_TEST_SUITE(SelectiveSegmentationTyped, PointTypes);
+
+TYPED_TEST(SelectiveSegmentationTyped, SameLabelsForEveryPointType)
+{
+  const auto truth = cubeScene(3000, 9);
+  auto cloud = pcl::make_shared<pcl::PointCloud<TypeParam>>();
+  for (const auto& p : *truth) {
+    TypeParam q;
+    q.getVector3fMap() = p.getVector3fMap();
+    cloud->push_back(q);
+  }
+  SelectiveSegmentation<TypeParam> seg;
+  SelectiveSegmentation<pcl::PointXYZL> reference;
+  std::vector<pcl::PointIndices> clusters;
+  ASSERT_TRUE(segment<TypeParam>(cloud, seg, clusters));
+  ASSERT_TRUE(segment<pcl::PointXYZL>(truth, reference, clusters));
+  EXPECT_EQ(seg.getResult().labels, reference.getResult().labels);
+}
+
+TEST(SelectiveSegmentation, PolygonMeshIndexesTheInputCloud)
+{
+  const auto cloud = cubeScene(3000, 4);
+  SelectiveSegmentation<pcl::PointXYZL> seg;
+  std::vector<pcl::PointIndices> clusters;
+  ASSERT_TRUE(segment<pcl::PointXYZL>(cloud, seg, clusters));
+  pcl::PolygonMesh mesh;
+  seg.getPolygonMesh(mesh);
+  EXPECT_EQ(mesh.cloud.width * mesh.cloud.height, cloud->size());
+  ASSERT_EQ(mesh.polygons.size(), seg.getResult().mesh.triangles.size());
+  for (const auto& poly : mesh.polygons) {
+    ASSERT_EQ(poly.vertices.size(), 3u);
+    for (const auto v : poly.vertices)
+      ASSERT_LT(v, cloud->size());
+  }
+}
+
+TEST(SelectiveSegmentation, VtkBackendSegmentsTheCubeScene)
+{
+  using pcl::selective_seg::DelaunayBackend;
+  if (!pcl::selective_seg::isDelaunayBackendAvailable(DelaunayBackend::Vtk))
+    GTEST_SKIP() << "built without VTK";
+  const auto truth = cubeScene(5432, 2);
+  SelectiveSegmentation<pcl::PointXYZL> seg;
+  seg.setDelaunayBackend(DelaunayBackend::Vtk);
+  std::vector<pcl::PointIndices> clusters;
+  ASSERT_TRUE(segment<pcl::PointXYZL>(truth, seg, clusters));
+  // Same five large segments as the exact backend.
+  std::size_t large = 0;
+  for (const auto& c : clusters)
+    large += c.indices.size() > 200;
+  EXPECT_EQ(large, 5u);
+}
+
+int
+main(int argc, char** argv)
+{
+  testing::InitGoogleTest(&argc, argv);
+  return RUN_ALL_TESTS();
+}
