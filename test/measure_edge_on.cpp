@@ -1,0 +1,94 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
+ */
+
+// Measures the effect of max_view_incidence_angle (the edge-on triangle test) on the
+// simulated cube scene and, when the data folder is given, on the mOSD frames. Prints
+// the markdown table of docs/parameters.md.
+//
+// Usage: selseg_measure_edge_on [shared_data_dir]
+
+#include <pcl_selective_seg/selective_segmentation.h>
+#include <synthetic_scenes.h>
+
+#include <pcl/io/pcd_io.h>
+
+#include <cstdio>
+#include <map>
+#include <string>
+
+namespace {
+
+struct Score {
+  double leakage = 0.0; // fraction of points in a segment of another majority label
+  std::size_t segments = 0;
+};
+
+Score
+score(const pcl::PointCloud<pcl::PointXYZL>::ConstPtr& cloud, double incidence)
+{
+  pcl::selective_seg::SelectiveSegmentation<pcl::PointXYZL> seg;
+  seg.setInputCloud(cloud);
+  seg.setMaxViewIncidenceAngle(incidence);
+  std::vector<pcl::PointIndices> segments;
+  Score s;
+  if (!seg.extract(segments))
+    return s;
+  std::size_t leaked = 0, total = 0;
+  for (const auto& c : segments) {
+    std::map<std::uint32_t, std::size_t> votes;
+    for (const auto i : c.indices)
+      if ((*cloud)[i].label != 0)
+        ++votes[(*cloud)[i].label];
+    std::size_t in = 0, majority = 0;
+    for (const auto& v : votes) {
+      in += v.second;
+      majority = std::max(majority, v.second);
+    }
+    leaked += in - majority;
+    total += in;
+  }
+  s.leakage = total ? static_cast<double>(leaked) / total : 0.0;
+  s.segments = segments.size();
+  return s;
+}
+
+void
+row(const std::string& name, const pcl::PointCloud<pcl::PointXYZL>::ConstPtr& cloud)
+{
+  const Score paper = score(cloud, M_PI / 2.0);
+  const Score edge_on = score(cloud, 85.0 * M_PI / 180.0);
+  std::printf("| %s | %zu | %.2f%% (%zu) | %.2f%% (%zu) |\n",
+              name.c_str(),
+              cloud->size(),
+              100.0 * paper.leakage,
+              paper.segments,
+              100.0 * edge_on.leakage,
+              edge_on.segments);
+}
+
+} // namespace
+
+int
+main(int argc, char** argv)
+{
+  std::printf("| scene | points | leakage (segments), 90 deg = paper | leakage "
+              "(segments), 85 deg |\n|---|---|---|---|\n");
+  for (const std::size_t rays : {5432, 46255})
+    for (const unsigned seed : {1u, 2u, 3u}) {
+      auto view = selseg_test::makeCubeOnTableView(rays);
+      view.seed = seed;
+      auto cloud = pcl::make_shared<pcl::PointCloud<pcl::PointXYZL>>(
+          selseg_test::scan(selseg_test::makeCubeOnTableScene(), view));
+      row("cube, seed " + std::to_string(seed), cloud);
+    }
+  if (argc > 1)
+    for (const char* frame : {"learn0", "learn17", "test0"}) {
+      auto cloud = pcl::make_shared<pcl::PointCloud<pcl::PointXYZL>>();
+      if (pcl::io::loadPCDFile(std::string(argv[1]) + "/mosd/" + frame + ".pcd", *cloud) == 0)
+        row(std::string("mOSD ") + frame, cloud);
+    }
+  return 0;
+}
