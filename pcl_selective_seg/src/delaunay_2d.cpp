@@ -4,11 +4,10 @@
  *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
  */
 
-#include <pcl_selective_seg/delaunay_2d.h>
+#include <boost/polygon/voronoi.hpp>
 
 #include "delaunay_2d_backends.h"
-
-#include <boost/polygon/voronoi.hpp>
+#include <pcl_selective_seg/delaunay_2d.h>
 
 #include <algorithm>
 #include <cstddef>
@@ -64,7 +63,7 @@ checkRange(const std::vector<QuantizedPoint>& points, std::string* error)
   return true;
 }
 
-/** Sortable 64-bit key of a point: same order as the lexicographic order (x, then y). */
+/** Sortable 64-bit key of a point, ordered like the points (x, then y). */
 std::uint64_t
 pointKey(const QuantizedPoint& p)
 {
@@ -332,8 +331,8 @@ refanGroup(const std::vector<QuantizedPoint>& points,
     corners.insert(corners.end(), triangles[t].begin(), triangles[t].end());
   std::sort(corners.begin(), corners.end());
   corners.erase(std::unique(corners.begin(), corners.end()), corners.end());
-  const auto first = std::min_element(
-      corners.begin(), corners.end(), [&](index_t a, index_t b) {
+  const auto first =
+      std::min_element(corners.begin(), corners.end(), [&](index_t a, index_t b) {
         return points[a] < points[b];
       });
   std::iter_swap(corners.begin(), first);
@@ -403,7 +402,8 @@ collectPolygon(const VoronoiDiagram& diagram,
                           ? static_cast<index_t>(end - diagram.vertices().data())
                           : -1);
     edge = edge->rot_next();
-  } while (edge != vertex.incident_edge());
+  }
+  while (edge != vertex.incident_edge());
 }
 
 /** Whether the co-circular \a polygon lies on a different empty circle than each
@@ -543,8 +543,9 @@ runBackend(const std::vector<QuantizedPoint>& points,
     break;
 #endif
   }
-  setError(error, std::string("delaunay2d: backend '") + toString(backend) +
-                      "' is not available in this build");
+  setError(error,
+           std::string("delaunay2d: backend '") + toString(backend) +
+               "' is not available in this build");
   return false;
 }
 

@@ -4,14 +4,14 @@
  *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
  */
 
-#include "delaunay_2d_backends.h"
-
 #include <vtkCellArray.h>
 #include <vtkCellArrayIterator.h>
 #include <vtkDelaunay2D.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkSmartPointer.h>
+
+#include "delaunay_2d_backends.h"
 
 namespace pcl {
 namespace selective_seg {

@@ -39,8 +39,10 @@ enum class DelaunayBackend : std::uint8_t {
   BoostVoronoi = 0,
   /** VTK's vtkDelaunay2D (the design's original choice). Available only when the
    * library was built with VTK (see isDelaunayBackendAvailable()). Floating point: it
-   * may drop thin triangles along the hull and does not split co-circular points by
-   * the canonical rule, so its output can differ from the exact backends. */
+   * may drop thin triangles along the hull (any triangle whose circumcircle reaches its
+   * initial bounding triangulation, which can include triangles one layer inside the
+   * hull) and does not split co-circular points by the canonical rule, so its output
+   * can differ from the exact backends. */
   Vtk = 1
 };
 
