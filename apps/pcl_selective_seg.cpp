@@ -45,11 +45,13 @@ void
 printHelp(const char* program)
 {
   const SelectiveSegmentationParameters d;
-  print_info("Segment a 3-D scan seen from one sensor viewpoint into surface segments.\n\n"
-             "Usage: %s input.pcd [options]\n\n",
-             program);
+  print_info(
+      "Segment a 3-D scan seen from one sensor viewpoint into surface segments.\n\n"
+      "Usage: %s input.pcd [options]\n\n",
+      program);
   print_info("Options (defaults are the paper's where it gives one):\n");
-  print_info("  -o FILE.pcd            labeled cloud (x y z label, input order and layout)\n");
+  print_info(
+      "  -o FILE.pcd            labeled cloud (x y z label, input order and layout)\n");
   print_info("  -split_deg X           octree split threshold on the normals' std dev "
              "[deg] (default %.1f)\n",
              d.max_normal_std_dev / kDeg);
@@ -59,9 +61,10 @@ printHelp(const char* program)
   print_info("  -edge_deg X            max angle of a valid edge triangle [deg] "
              "(default %.1f)\n",
              d.max_edge_triangle_angle / kDeg);
-  print_info("  -incidence_deg X       max view incidence of a valid edge triangle [deg]; "
-             "90 = off (default %.1f)\n",
-             d.max_view_incidence_angle / kDeg);
+  print_info(
+      "  -incidence_deg X       max view incidence of a valid edge triangle [deg]; "
+      "90 = off (default %.1f)\n",
+      d.max_view_incidence_angle / kDeg);
   print_info("  -min_voxel_m X         smallest octree voxel [m]; 0 = %.1f x median "
              "point spacing (default %g)\n",
              d.min_voxel_size_factor,
@@ -69,13 +72,15 @@ printHelp(const char* program)
   print_info("  -min_split_points N    voxels with fewer points are not split "
              "(default %d)\n",
              d.min_points_to_split);
-  print_info("  -backend NAME          Delaunay backend: boost or vtk (default boost)\n");
+  print_info(
+      "  -backend NAME          Delaunay backend: boost or vtk (default boost)\n");
   print_info("  -ignore_viewpoint      take the sensor at the origin looking along +z, "
              "whatever the file's VIEWPOINT says\n");
   print_info("  -h, --help             this help\n");
 }
 
-/** A checked numeric option: absent is fine, present and unparsable is a usage error. */
+/** A checked numeric option: absent is fine, present and unparsable is a usage error.
+ */
 template <typename T>
 bool
 parseChecked(int argc, char** argv, const char* flag, T& value)
@@ -144,10 +149,21 @@ printTimings(const pcl::selective_seg::SegmentationResult& r, std::size_t points
 {
   const auto& t = r.timings;
   print_info("\n  %-10s %9s %12s %13s %11s %13s %9s\n",
-             "", "# Points", "Delaunay (s)", "Normals (s)", "Octree (s)",
-             "Merge (s)", "Total (s)");
+             "",
+             "# Points",
+             "Delaunay (s)",
+             "Normals (s)",
+             "Octree (s)",
+             "Merge (s)",
+             "Total (s)");
   print_info("  %-10s %9zu %12.4f %13.4f %11.4f %13.4f %9.4f\n\n",
-             "this scan", points, t.delaunay, t.normals, t.octree, t.merge, t.total);
+             "this scan",
+             points,
+             t.delaunay,
+             t.normals,
+             t.octree,
+             t.merge,
+             t.total);
 }
 
 void
@@ -159,10 +175,16 @@ printSummary(const pcl::selective_seg::SegmentationResult& r)
     large += s.num_points >= 0.01 * c.labeled;
   print_info("Segments: %zu (%zu with at least 1%% of the labeled points); octree "
              "leaves: %zu; triangles: %zu\n",
-             r.segments.size(), large, r.leaves.size(), r.mesh.triangles.size());
+             r.segments.size(),
+             large,
+             r.leaves.size(),
+             r.mesh.triangles.size());
   print_info("Points: %zu labeled (%zu sharing a mesh vertex), %zu non-finite, %zu "
              "behind the sensor, %zu without a normal\n",
-             c.labeled, c.shared_vertex, c.non_finite, c.behind_sensor,
+             c.labeled,
+             c.shared_vertex,
+             c.non_finite,
+             c.behind_sensor,
              c.without_normal);
 }
 
@@ -178,7 +200,9 @@ saveLabeled(const std::string& path, const pcl::PointCloud<pcl::PointXYZL>& clou
     return false;
   }
   if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    print_error("Cannot rename '%s' to '%s': %s\n", tmp.c_str(), path.c_str(),
+    print_error("Cannot rename '%s' to '%s': %s\n",
+                tmp.c_str(),
+                path.c_str(),
                 std::strerror(errno));
     std::remove(tmp.c_str());
     return false;
@@ -203,11 +227,16 @@ main(int argc, char** argv)
   timer.tic();
   auto cloud = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
   if (pcl::io::loadPCDFile(opt.input, *cloud) != 0) {
-    print_error("Cannot read '%s' as a PCD file with x y z fields.\n", opt.input.c_str());
+    print_error("Cannot read '%s' as a PCD file with x y z fields.\n",
+                opt.input.c_str());
     return kRuntimeError;
   }
-  print_info("Loaded '%s' [done, %g ms : %zu points, %u x %u]\n", opt.input.c_str(),
-             timer.toc(), cloud->size(), cloud->width, cloud->height);
+  print_info("Loaded '%s' [done, %g ms : %zu points, %u x %u]\n",
+             opt.input.c_str(),
+             timer.toc(),
+             cloud->size(),
+             cloud->width,
+             cloud->height);
 
   pcl::selective_seg::SelectiveSegmentation<pcl::PointXYZ> seg;
   seg.setParameters(opt.params);
@@ -218,9 +247,10 @@ main(int argc, char** argv)
   if (!seg.extract(segments)) {
     const auto& c = seg.getResult().counts;
     if (c.behind_sensor > 0 && c.behind_sensor + c.non_finite == cloud->size())
-      print_error("Every point lies behind the sensor pose given by the file's VIEWPOINT; "
-                  "if the cloud is in the camera frame (z forward), pass "
-                  "-ignore_viewpoint.\n");
+      print_error(
+          "Every point lies behind the sensor pose given by the file's VIEWPOINT; "
+          "if the cloud is in the camera frame (z forward), pass "
+          "-ignore_viewpoint.\n");
     print_error("Segmentation failed (reason above).\n");
     return kRuntimeError;
   }
@@ -231,7 +261,9 @@ main(int argc, char** argv)
     timer.tic();
     if (!saveLabeled(opt.output, *seg.getLabeledCloud()))
       return kRuntimeError;
-    print_info("Wrote '%s' [done, %g ms : %zu points]\n", opt.output.c_str(), timer.toc(),
+    print_info("Wrote '%s' [done, %g ms : %zu points]\n",
+               opt.output.c_str(),
+               timer.toc(),
                cloud->size());
   }
   return 0;

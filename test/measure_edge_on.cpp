@@ -11,13 +11,14 @@
 // Usage: selseg_measure_edge_on [shared_data_dir]
 
 #include <pcl_selective_seg/selective_segmentation.h>
-#include <synthetic_scenes.h>
 
 #include <pcl/io/pcd_io.h>
 
 #include <cstdio>
 #include <map>
 #include <string>
+
+#include <synthetic_scenes.h>
 
 namespace {
 
@@ -87,7 +88,8 @@ main(int argc, char** argv)
   if (argc > 1)
     for (const char* frame : {"learn0", "learn17", "test0"}) {
       auto cloud = pcl::make_shared<pcl::PointCloud<pcl::PointXYZL>>();
-      if (pcl::io::loadPCDFile(std::string(argv[1]) + "/mosd/" + frame + ".pcd", *cloud) == 0)
+      if (pcl::io::loadPCDFile(std::string(argv[1]) + "/mosd/" + frame + ".pcd",
+                               *cloud) == 0)
         row(std::string("mOSD ") + frame, cloud);
     }
   return 0;

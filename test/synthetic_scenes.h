@@ -6,10 +6,9 @@
 
 #pragma once
 
+#include <Eigen/Core>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
-
-#include <Eigen/Core>
 
 #include <cstddef>
 #include <cstdint>
@@ -58,12 +57,11 @@ struct Scene {
  * \param[in] first_label label of the first face (>= 1).
  * \return the next unused label, first_label + 6.
  */
-std::uint32_t
-addBox(Scene& scene,
-       const Eigen::Vector3d& centre,
-       const Eigen::Vector3d& half_sizes,
-       double yaw,
-       std::uint32_t first_label);
+std::uint32_t addBox(Scene& scene,
+                     const Eigen::Vector3d& centre,
+                     const Eigen::Vector3d& half_sizes,
+                     double yaw,
+                     std::uint32_t first_label);
 
 /** \brief How scan() draws its rays.
  *
@@ -103,8 +101,7 @@ struct SamplingParams {
  * \param[in] phi vertical angle [rad].
  * \return density relative to the sparsest corner, in [1, density_ratio].
  */
-double
-relativeDensity(const SamplingParams& params, double theta, double phi);
+double relativeDensity(const SamplingParams& params, double theta, double phi);
 
 /** \brief Cast rays from the origin into a scene.
  *
@@ -132,14 +129,12 @@ scan(const Scene& scene,
  * Seen through makeCubeOnTableView(), the sensor sees the wall, the table top and
  * exactly three cube faces: the top (3), the +x face (6) and the -z face (7).
  */
-Scene
-makeCubeOnTableScene();
+Scene makeCubeOnTableScene();
 
 /** \brief A view window framing makeCubeOnTableScene() (other fields at defaults).
  *
  * \param[in] num_rays number of rays to cast.
  */
-SamplingParams
-makeCubeOnTableView(std::size_t num_rays = 5000);
+SamplingParams makeCubeOnTableView(std::size_t num_rays = 5000);
 
 } // namespace selseg_test

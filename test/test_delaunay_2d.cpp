@@ -4,9 +4,9 @@
  *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
  */
 
-#include <gtest/gtest.h>
-
 #include <pcl_selective_seg/delaunay_2d.h>
+
+#include <gtest/gtest.h>
 
 #include <algorithm>
 #include <array>
@@ -508,8 +508,7 @@ TEST(Delaunay2D, CoCircularQuadrilateralsFollowTheFanInEveryInputOrder)
       }
       EXPECT_EQ(triangulate(points),
                 canonical({{id[0], id[1], id[2]}, {id[0], id[2], id[3]}}));
-    }
-    while (std::next_permutation(order.begin(), order.end()));
+    } while (std::next_permutation(order.begin(), order.end()));
   }
 }
 

@@ -53,9 +53,10 @@ leakage(const pcl::PointCloud<pcl::PointXYZL>& truth,
 
 class MosdFrame : public ::testing::TestWithParam<const char*> {};
 
-// The mOSD labels are object parts (a box is one label), so splitting a box into faces is
-// expected; merging a box with the table is not. Measured with the default parameters:
-// learn0 0.14%, learn17 0.18%, test0 0.09% of the points leak; asserted below 0.5%.
+// The mOSD labels are object parts (a box is one label), so splitting a box into faces
+// is expected; merging a box with the table is not. Measured with the default
+// parameters: learn0 0.14%, learn17 0.18%, test0 0.09% of the points leak; asserted
+// below 0.5%.
 TEST_P(MosdFrame, SegmentsDoNotLeakAcrossObjects)
 {
   auto cloud = pcl::make_shared<pcl::PointCloud<pcl::PointXYZL>>();

@@ -4,12 +4,11 @@
  *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
  */
 
-// End-to-end tests of SelectiveSegmentation: ground-truth scenes, invariances, bad input
-// and the agreement of the labels, the mesh and the octree.
+// End-to-end tests of SelectiveSegmentation: ground-truth scenes, invariances, bad
+// input and the agreement of the labels, the mesh and the octree.
 
 #include <pcl_selective_seg/point_types.h>
 #include <pcl_selective_seg/selective_segmentation.h>
-#include <synthetic_scenes.h>
 
 #include <boost/preprocessor/seq/enum.hpp>
 #include <gtest/gtest.h>
@@ -21,6 +20,8 @@
 #include <numeric>
 #include <random>
 #include <set>
+
+#include <synthetic_scenes.h>
 
 using pcl::selective_seg::SelectiveSegmentation;
 using Labeled = pcl::PointCloud<pcl::PointXYZL>;
@@ -91,12 +92,14 @@ TEST(SelectiveSegmentation, CubeSceneGivesOneSegmentPerFace)
       for (const auto& s : segments)
         face_points += s.second;
       // One segment covers the face (the rest: small edge segments along its border).
-      EXPECT_GT(best->second, 0.85 * face_points) << "face " << face << " seed " << seed;
-      EXPECT_TRUE(used.insert(best->first).second) << "two faces share segment "
-                                                   << best->first;
+      EXPECT_GT(best->second, 0.85 * face_points)
+          << "face " << face << " seed " << seed;
+      EXPECT_TRUE(used.insert(best->first).second)
+          << "two faces share segment " << best->first;
       // ... and it is pure: at most 5% of its points come from other faces.
       const std::size_t size = clusters[best->first - 1].indices.size();
-      EXPECT_LT(size - best->second, 0.05 * size) << "face " << face << " seed " << seed;
+      EXPECT_LT(size - best->second, 0.05 * size)
+          << "face " << face << " seed " << seed;
     }
   }
 }
@@ -112,9 +115,10 @@ TEST(SelectiveSegmentation, EdgeOnTrianglesJoinParallelPlanesWhenNotExcluded)
   ASSERT_TRUE(segment<pcl::PointXYZL>(truth, seg, clusters));
   const auto table = overlap(*truth, seg.getResult().labels);
   const auto dominant = [&](std::uint32_t face) {
-    return std::max_element(table.at(face).begin(),
-                            table.at(face).end(),
-                            [](const auto& a, const auto& b) { return a.second < b.second; })
+    return std::max_element(
+               table.at(face).begin(),
+               table.at(face).end(),
+               [](const auto& a, const auto& b) { return a.second < b.second; })
         ->first;
   };
   EXPECT_EQ(dominant(2), dominant(3)); // table and cube top: one segment
@@ -188,7 +192,8 @@ TEST(SelectiveSegmentation, LabelsMeshAndOctreeAgree)
   using pcl::selective_seg::TriangleClass;
   for (std::size_t t = 0; t < r.mesh.triangles.size(); ++t) {
     const auto& tri = r.mesh.triangles[t];
-    const std::set<std::uint32_t> vl{r.labels[tri[0]], r.labels[tri[1]], r.labels[tri[2]]};
+    const std::set<std::uint32_t> vl{
+        r.labels[tri[0]], r.labels[tri[1]], r.labels[tri[2]]};
     if (r.mesh.classes[t] == TriangleClass::Interior)
       EXPECT_EQ(vl, std::set<std::uint32_t>{r.mesh.labels[t]});
     else
@@ -409,8 +414,8 @@ TEST(SelectiveSegmentation, ExtremeCoordinatesDoNotBreakIt)
 }
 
 // Every instantiated point type gives the same result on the same coordinates.
-template <typename PointT>
-class SelectiveSegmentationTyped : public ::testing::Test {};
+template <typename PointT> class SelectiveSegmentationTyped : public ::testing::Test {
+};
 using PointTypes = ::testing::Types<BOOST_PP_SEQ_ENUM(PCL_SELSEG_POINT_TYPES)>;
 TYPED_TEST_SUITE(SelectiveSegmentationTyped, PointTypes);
 

@@ -4,11 +4,8 @@
  *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
  */
 
-#include "synthetic_scenes.h"
-
-#include <gtest/gtest.h>
-
 #include <Eigen/Geometry>
+#include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
@@ -17,6 +14,8 @@
 #include <set>
 #include <stdexcept>
 #include <vector>
+
+#include "synthetic_scenes.h"
 
 namespace {
 
@@ -132,8 +131,7 @@ TEST(SyntheticScenes, NearestFaceOccludesFartherOnes)
     if (point.label == 2) {
       ++near_count;
       EXPECT_NEAR(point.z, 1.0, 1e-6);
-    }
-    else {
+    } else {
       EXPECT_NEAR(point.z, 3.0, 1e-6);
       EXPECT_FALSE(behind_near) << x << " " << y;
     }
@@ -143,8 +141,8 @@ TEST(SyntheticScenes, NearestFaceOccludesFartherOnes)
 
 TEST(SyntheticScenes, CubeSceneShowsWallTableAndThreeCubeFaces)
 {
-  const Cloud cloud = scan(selseg_test::makeCubeOnTableScene(),
-                           selseg_test::makeCubeOnTableView(5000));
+  const Cloud cloud =
+      scan(selseg_test::makeCubeOnTableScene(), selseg_test::makeCubeOnTableView(5000));
   const std::map<std::uint32_t, int> counts = labelCounts(cloud);
   std::set<std::uint32_t> labels;
   for (const auto& entry : counts) {
@@ -190,8 +188,8 @@ measuredDensityRatio(const SamplingParams& params)
   const double d_phi = (params.phi_max - params.phi_min) / kCells;
   std::vector<int> counts(kCells * kCells, 0);
   for (const auto& point : cloud) {
-    const int i = static_cast<int>((std::atan2(point.x, point.z) - params.theta_min) /
-                                   d_theta);
+    const int i =
+        static_cast<int>((std::atan2(point.x, point.z) - params.theta_min) / d_theta);
     const int j =
         static_cast<int>((std::atan2(point.y, point.z) - params.phi_min) / d_phi);
     ++counts[std::clamp(i, 0, kCells - 1) * kCells + std::clamp(j, 0, kCells - 1)];
@@ -199,10 +197,9 @@ measuredDensityRatio(const SamplingParams& params)
   std::vector<double> density(counts.size());
   for (int i = 0; i < kCells; ++i)
     for (int j = 0; j < kCells; ++j)
-      density[i * kCells + j] =
-          relativeDensity(params,
-                          params.theta_min + (i + 0.5) * d_theta,
-                          params.phi_min + (j + 0.5) * d_phi);
+      density[i * kCells + j] = relativeDensity(params,
+                                                params.theta_min + (i + 0.5) * d_theta,
+                                                params.phi_min + (j + 0.5) * d_phi);
   std::vector<int> order(counts.size());
   std::iota(order.begin(), order.end(), 0);
   std::sort(order.begin(), order.end(), [&](int a, int b) {

@@ -4,10 +4,9 @@
  *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
  */
 
-#include <boost/polygon/voronoi.hpp>
-
-#include "delaunay_2d_backends.h"
 #include <pcl_selective_seg/delaunay_2d.h>
+
+#include <boost/polygon/voronoi.hpp>
 
 #include <algorithm>
 #include <cstddef>
@@ -15,6 +14,8 @@
 #include <limits>
 #include <numeric>
 #include <utility>
+
+#include "delaunay_2d_backends.h"
 
 namespace pcl {
 namespace selective_seg {
@@ -402,8 +403,7 @@ collectPolygon(const VoronoiDiagram& diagram,
                           ? static_cast<index_t>(end - diagram.vertices().data())
                           : -1);
     edge = edge->rot_next();
-  }
-  while (edge != vertex.incident_edge());
+  } while (edge != vertex.incident_edge());
 }
 
 /** Whether the co-circular \a polygon lies on a different empty circle than each

@@ -72,20 +72,18 @@ inCircle(const QuantizedPoint& a,
  * counter-clockwise but not in canonical order. Returns false, with a message, only if
  * the Voronoi diagram cannot be turned into a triangulation (an internal error).
  */
-bool
-delaunayBoostVoronoi(const std::vector<QuantizedPoint>& points,
-                     std::vector<Triangle>& triangles,
-                     std::string* error);
+bool delaunayBoostVoronoi(const std::vector<QuantizedPoint>& points,
+                          std::vector<Triangle>& triangles,
+                          std::string* error);
 
 /** \brief Triangulation by vtkDelaunay2D (floating point), triangles oriented counter-
  * clockwise by the exact orientation, degenerate ones dropped, not in canonical order.
  *
  * Defined only when the library is built with VTK (PCL_SELSEG_HAVE_VTK).
  */
-bool
-delaunayVtk(const std::vector<QuantizedPoint>& points,
-            std::vector<Triangle>& triangles,
-            std::string* error);
+bool delaunayVtk(const std::vector<QuantizedPoint>& points,
+                 std::vector<Triangle>& triangles,
+                 std::string* error);
 
 } // namespace detail
 } // namespace selective_seg

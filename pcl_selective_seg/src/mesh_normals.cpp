@@ -97,7 +97,8 @@ markEdgeOnTriangles(const Vector3fVector& positions,
 }
 
 double
-medianEdgeLength(const Vector3fVector& positions, const std::vector<Triangle>& triangles)
+medianEdgeLength(const Vector3fVector& positions,
+                 const std::vector<Triangle>& triangles)
 {
   if (triangles.empty())
     return 0.0;

@@ -11,7 +11,7 @@
 
 // The header always includes the bodies (custom-container octrees are usually compiled
 // by their users); these instantiations are compiled once here and checked.
-#define PCL_INSTANTIATE_OctreePointCloudNormalVariance(T)                             \
+#define PCL_INSTANTIATE_OctreePointCloudNormalVariance(T)                              \
   template class PCL_EXPORTS pcl::selective_seg::OctreePointCloudNormalVariance<T>;
 
 PCL_INSTANTIATE(OctreePointCloudNormalVariance, PCL_SELSEG_POINT_TYPES)

@@ -40,7 +40,8 @@ SelectiveSegmentationParameters::validate(std::string* why) const
   if (!inRange(max_merge_angle, 0.0, M_PI))
     return reject(why, "max_merge_angle [rad]", max_merge_angle, "[0, pi]");
   if (!inRange(max_edge_triangle_angle, 0.0, M_PI))
-    return reject(why, "max_edge_triangle_angle [rad]", max_edge_triangle_angle, "[0, pi]");
+    return reject(
+        why, "max_edge_triangle_angle [rad]", max_edge_triangle_angle, "[0, pi]");
   if (!inRange(max_view_incidence_angle, 0.0, M_PI / 2.0) ||
       max_view_incidence_angle == 0.0)
     return reject(
@@ -54,7 +55,8 @@ SelectiveSegmentationParameters::validate(std::string* why) const
   if (max_octree_depth < 1 || max_octree_depth > 21)
     return reject(why, "max_octree_depth", max_octree_depth, "[1, 21]");
   if (!inRange(angle_quantization, 2.5e-8, 1e-2))
-    return reject(why, "angle_quantization [rad]", angle_quantization, "[2.5e-8, 1e-2]");
+    return reject(
+        why, "angle_quantization [rad]", angle_quantization, "[2.5e-8, 1e-2]");
   if (!isDelaunayBackendAvailable(delaunay_backend)) {
     if (why)
       *why = std::string("parameter delaunay_backend = ") + toString(delaunay_backend) +

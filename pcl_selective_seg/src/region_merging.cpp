@@ -56,8 +56,7 @@ struct GrowingSegment {
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();
 
-  void
-  add(const Eigen::Vector3f& leaf_normal, double leaf_area)
+  void add(const Eigen::Vector3f& leaf_normal, double leaf_area)
   {
     if (leaf_area > 0.0 && std::isfinite(leaf_area))
       sum += leaf_normal.cast<double>() / leaf_area;
@@ -86,15 +85,15 @@ seedOrder(const Incidence& leaf_vertices)
 class SeedMerger {
 public:
   explicit SeedMerger(const MergeInput& in)
-  : in_(in)
-  , leaf_vertices_(Incidence::build(*in.vertex_leaf, in.leaf_normals->size()))
-  , vertex_triangles_(vertexTriangles(*in.triangles, in.vertex_leaf->size()))
-  , cos_merge_(std::cos(in.max_merge_angle))
-  , cos_edge_(std::cos(in.max_edge_triangle_angle))
-  {}
+      : in_(in)
+      , leaf_vertices_(Incidence::build(*in.vertex_leaf, in.leaf_normals->size()))
+      , vertex_triangles_(vertexTriangles(*in.triangles, in.vertex_leaf->size()))
+      , cos_merge_(std::cos(in.max_merge_angle))
+      , cos_edge_(std::cos(in.max_edge_triangle_angle))
+  {
+  }
 
-  void
-  run(std::vector<pcl::index_t>& leaf_segment, Vector3fVector& segment_normals)
+  void run(std::vector<pcl::index_t>& leaf_segment, Vector3fVector& segment_normals)
   {
     leaf_segment.assign(in_.leaf_normals->size(), -1);
     segment_normals.clear();
@@ -117,18 +116,18 @@ private:
     while (!queue.empty()) {
       const auto leaf = queue.front();
       queue.pop_front();
-      for (auto i = leaf_vertices_.offsets[leaf]; i < leaf_vertices_.offsets[leaf + 1]; ++i)
+      for (auto i = leaf_vertices_.offsets[leaf]; i < leaf_vertices_.offsets[leaf + 1];
+           ++i)
         visitVertex(leaf_vertices_.items[i], k, segment, leaf_segment, queue);
     }
     return segment.normal;
   }
 
-  void
-  visitVertex(pcl::index_t vertex,
-              pcl::index_t k,
-              GrowingSegment& segment,
-              std::vector<pcl::index_t>& leaf_segment,
-              std::deque<pcl::index_t>& queue)
+  void visitVertex(pcl::index_t vertex,
+                   pcl::index_t k,
+                   GrowingSegment& segment,
+                   std::vector<pcl::index_t>& leaf_segment,
+                   std::deque<pcl::index_t>& queue)
   {
     const auto& vertex_leaf = *in_.vertex_leaf;
     for (auto i = vertex_triangles_.offsets[vertex];
@@ -147,7 +146,7 @@ private:
           continue;
         const Eigen::Vector3f& n_other = (*in_.leaf_normals)[other];
         if (n_other.cast<double>().dot(segment.normal) < cos_merge_)
-          continue; // eq. 9
+          continue;              // eq. 9
         leaf_segment[other] = k; // eq. 10
         segment.add(n_other, (*in_.leaf_areas)[other]);
         queue.push_back(other);
@@ -155,8 +154,7 @@ private:
     }
   }
 
-  bool
-  isValidFor(pcl::index_t t, const Eigen::Vector3d& segment_normal) const
+  bool isValidFor(pcl::index_t t, const Eigen::Vector3d& segment_normal) const
   {
     const Eigen::Vector3f& n_t = (*in_.triangle_normals)[t];
     if (!n_t.allFinite() || (in_.triangle_edge_on && (*in_.triangle_edge_on)[t]))

@@ -11,7 +11,7 @@ main()
   for (int i = 0; i < 40; ++i)
     for (int j = 0; j < 40; ++j) {
       const float u = -0.5f + i / 40.0f, v = -0.5f + j / 40.0f;
-      cloud->push_back(pcl::PointXYZ(u, v, 2.0f));             // wall facing the sensor
+      cloud->push_back(pcl::PointXYZ(u, v, 2.0f)); // wall facing the sensor
       cloud->push_back(pcl::PointXYZ(u, 0.6f, 1.0f + (v + 0.5f))); // floor below it
     }
   pcl::selective_seg::SelectiveSegmentation<pcl::PointXYZ> seg;

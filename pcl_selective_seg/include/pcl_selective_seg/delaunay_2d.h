@@ -35,7 +35,8 @@ using Triangle = std::array<pcl::index_t, 3>;
 
 /** \brief Delaunay backends. */
 enum class DelaunayBackend : std::uint8_t {
-  /** Dual of Boost.Polygon's exact Voronoi diagram (default; BSD-compatible licence). */
+  /** Dual of Boost.Polygon's exact Voronoi diagram (default; BSD-compatible licence).
+   */
   BoostVoronoi = 0,
   /** VTK's vtkDelaunay2D (the design's original choice). Available only when the
    * library was built with VTK (see isDelaunayBackendAvailable()). Floating point: it
@@ -47,12 +48,10 @@ enum class DelaunayBackend : std::uint8_t {
 };
 
 /** \brief Human-readable backend name ("boost", "vtk"). */
-PCL_EXPORTS const char*
-toString(DelaunayBackend backend);
+PCL_EXPORTS const char* toString(DelaunayBackend backend);
 
 /** \brief Whether the backend was compiled into this build of the library. */
-PCL_EXPORTS bool
-isDelaunayBackendAvailable(DelaunayBackend backend);
+PCL_EXPORTS bool isDelaunayBackendAvailable(DelaunayBackend backend);
 
 /** \brief Delaunay triangulation of distinct 2-D integer points.
  *
@@ -68,30 +67,27 @@ isDelaunayBackendAvailable(DelaunayBackend backend);
  *         empty). Fewer than three points, or all points collinear, is not a failure:
  *         the result is then empty.
  *
- * Groups of four or more co-circular points (every regular grid has them) have no unique
- * Delaunay triangulation. The exact backends split each such empty circle's polygon by a
- * rule that depends only on the coordinates: a fan from the polygon's lexicographically
- * smallest point (smallest x, then smallest y). Point ids do not matter, so a permuted
- * input gives the same triangles up to the renaming of the ids.
+ * Groups of four or more co-circular points (every regular grid has them) have no
+ * unique Delaunay triangulation. The exact backends split each such empty circle's
+ * polygon by a rule that depends only on the coordinates: a fan from the polygon's
+ * lexicographically smallest point (smallest x, then smallest y). Point ids do not
+ * matter, so a permuted input gives the same triangles up to the renaming of the ids.
  */
-PCL_EXPORTS bool
-delaunay2d(const std::vector<QuantizedPoint>& points,
-           DelaunayBackend backend,
-           std::vector<Triangle>& triangles,
-           std::string* error = nullptr);
+PCL_EXPORTS bool delaunay2d(const std::vector<QuantizedPoint>& points,
+                            DelaunayBackend backend,
+                            std::vector<Triangle>& triangles,
+                            std::string* error = nullptr);
 
 /** \brief Triangle adjacency of a triangle mesh.
  *
- * \param[in] triangles triangles over vertex ids 0..num_vertices-1, consistently oriented.
- * \param[in] num_vertices number of vertices.
- * \param[out] neighbours neighbours[t][i] is the triangle sharing the edge opposite
- *             vertex i of triangle t (the edge triangles[t][(i+1)%3] -
- *             triangles[t][(i+2)%3]), or -1 on the boundary.
+ * \param[in] triangles triangles over vertex ids 0..num_vertices-1, consistently
+ * oriented. \param[in] num_vertices number of vertices. \param[out] neighbours
+ * neighbours[t][i] is the triangle sharing the edge opposite vertex i of triangle t
+ * (the edge triangles[t][(i+1)%3] - triangles[t][(i+2)%3]), or -1 on the boundary.
  */
-PCL_EXPORTS void
-computeTriangleNeighbours(const std::vector<Triangle>& triangles,
-                          std::size_t num_vertices,
-                          std::vector<Triangle>& neighbours);
+PCL_EXPORTS void computeTriangleNeighbours(const std::vector<Triangle>& triangles,
+                                           std::size_t num_vertices,
+                                           std::vector<Triangle>& neighbours);
 
 } // namespace selective_seg
 } // namespace pcl

@@ -30,12 +30,11 @@ using Vector3fVector = std::vector<Eigen::Vector3f>;
  * \param[out] areas #T areas A_t [m^2], computed in double precision (finite for any
  *             finite float input)
  */
-PCL_EXPORTS void
-computeTriangleNormals(const Vector3fVector& positions,
-                       const std::vector<Triangle>& triangles,
-                       const Eigen::Vector3f& viewpoint,
-                       Vector3fVector& normals,
-                       std::vector<double>& areas);
+PCL_EXPORTS void computeTriangleNormals(const Vector3fVector& positions,
+                                        const std::vector<Triangle>& triangles,
+                                        const Eigen::Vector3f& viewpoint,
+                                        Vector3fVector& normals,
+                                        std::vector<double>& areas);
 
 /** \brief Point normals (eq. 2) and point areas (eq. 3).
  *
@@ -50,18 +49,17 @@ computeTriangleNormals(const Vector3fVector& positions,
  *             or the weighted normals cancel
  * \param[out] vertex_areas #V areas A_p [m^2]
  */
-PCL_EXPORTS void
-computeVertexNormals(std::size_t num_vertices,
-                     const std::vector<Triangle>& triangles,
-                     const Vector3fVector& normals,
-                     const std::vector<double>& areas,
-                     Vector3fVector& vertex_normals,
-                     std::vector<double>& vertex_areas);
+PCL_EXPORTS void computeVertexNormals(std::size_t num_vertices,
+                                      const std::vector<Triangle>& triangles,
+                                      const Vector3fVector& normals,
+                                      const std::vector<double>& areas,
+                                      Vector3fVector& vertex_normals,
+                                      std::vector<double>& vertex_areas);
 
 /** \brief Flag the triangles seen edge-on from the viewpoint.
  *
- * A triangle whose normal makes more than \a max_incidence with the line of sight to its
- * centroid spans a depth discontinuity rather than a surface.
+ * A triangle whose normal makes more than \a max_incidence with the line of sight to
+ * its centroid spans a depth discontinuity rather than a surface.
  *
  * \param[in] positions #V vertex positions [m]
  * \param[in] triangles #T triangles
@@ -70,18 +68,17 @@ computeVertexNormals(std::size_t num_vertices,
  * \param[in] max_incidence [rad]; pi/2 or more flags only degenerate triangles
  * \param[out] edge_on #T 1 = seen edge-on
  */
-PCL_EXPORTS void
-markEdgeOnTriangles(const Vector3fVector& positions,
-                    const std::vector<Triangle>& triangles,
-                    const Vector3fVector& normals,
-                    const Eigen::Vector3f& viewpoint,
-                    double max_incidence,
-                    std::vector<std::uint8_t>& edge_on);
+PCL_EXPORTS void markEdgeOnTriangles(const Vector3fVector& positions,
+                                     const std::vector<Triangle>& triangles,
+                                     const Vector3fVector& normals,
+                                     const Eigen::Vector3f& viewpoint,
+                                     double max_incidence,
+                                     std::vector<std::uint8_t>& edge_on);
 
 /** \brief Median 3-D length of the triangles' edges [m] (each interior edge counted
  * twice); 0 for an empty mesh. The octree's automatic minimum voxel size scales it. */
-PCL_EXPORTS double
-medianEdgeLength(const Vector3fVector& positions, const std::vector<Triangle>& triangles);
+PCL_EXPORTS double medianEdgeLength(const Vector3fVector& positions,
+                                    const std::vector<Triangle>& triangles);
 
 } // namespace selective_seg
 } // namespace pcl

@@ -19,31 +19,21 @@ namespace selective_seg {
  * contiguous range, so the statistics of eq. 4-5 of any node are one pass over it. */
 class OctreeNormalVarianceContainer : public pcl::octree::OctreeContainerPointIndices {
 public:
-  OctreeNormalVarianceContainer*
-  deepCopy() const override
+  OctreeNormalVarianceContainer* deepCopy() const override
   {
     return new OctreeNormalVarianceContainer(*this);
   }
 
-  void
-  reset() override
+  void reset() override
   {
     pcl::octree::OctreeContainerPointIndices::reset();
     first_ = 0;
   }
 
   /** \brief Position of this voxel's first point in the depth-first ordering. */
-  std::size_t
-  getFirstOrderedPoint() const
-  {
-    return first_;
-  }
+  std::size_t getFirstOrderedPoint() const { return first_; }
 
-  void
-  setFirstOrderedPoint(std::size_t first)
-  {
-    first_ = first;
-  }
+  void setFirstOrderedPoint(std::size_t first) { first_ = first; }
 
 private:
   std::size_t first_ = 0;

@@ -25,9 +25,9 @@ struct AdaptiveLeaf {
   std::size_t begin = 0;      ///< its points: getOrderedIndices()[begin, end)
   std::size_t end = 0;
   Eigen::Vector3f normal = Eigen::Vector3f::Zero(); ///< N_v (eq. 4), input orientation
-  double area = 0.0;          ///< A_v = sum of A_p (eq. 6)
-  float sigma_theta = 0.0f;   ///< eq. 5 [rad]
-  float sigma_phi = 0.0f;     ///< eq. 5 [rad]
+  double area = 0.0;                                ///< A_v = sum of A_p (eq. 6)
+  float sigma_theta = 0.0f;                         ///< eq. 5 [rad]
+  float sigma_phi = 0.0f;                           ///< eq. 5 [rad]
 };
 
 /** \brief Multi-resolution octree whose voxels split while their normals vary (paper,
@@ -50,9 +50,9 @@ struct AdaptiveLeaf {
  */
 template <typename PointT>
 class OctreePointCloudNormalVariance
-: public pcl::octree::OctreePointCloud<PointT,
-                                       OctreeNormalVarianceContainer,
-                                       pcl::octree::OctreeContainerEmpty> {
+    : public pcl::octree::OctreePointCloud<PointT,
+                                           OctreeNormalVarianceContainer,
+                                           pcl::octree::OctreeContainerEmpty> {
 public:
   using Ptr = pcl::shared_ptr<OctreePointCloudNormalVariance<PointT>>;
   using ConstPtr = pcl::shared_ptr<const OctreePointCloudNormalVariance<PointT>>;
@@ -69,13 +69,11 @@ public:
   /** \brief Per-point normals and point areas A_p (eq. 3), indexed like the input
    * cloud. Points whose normal is not finite or whose area is not positive are skipped
    * by addPointsFromInputCloud(). */
-  void
-  setInputNormals(const NormalCloudConstPtr& normals, const AreasConstPtr& areas);
+  void setInputNormals(const NormalCloudConstPtr& normals, const AreasConstPtr& areas);
 
   /** \brief Orientation of the sensor in the cloud frame (the angles of eq. 5 are
    * measured in the sensor frame). Default: identity. */
-  void
-  setSensorOrientation(const Eigen::Quaternionf& orientation)
+  void setSensorOrientation(const Eigen::Quaternionf& orientation)
   {
     sensor_orientation_ = orientation;
   }
@@ -83,35 +81,23 @@ public:
   /** \brief Fit the bounding box to the valid points and insert them. Replaces
    * OctreePointCloud::addPointsFromInputCloud (which ignores normals and grows the
    * box in insertion order). \return false when no point is valid. */
-  bool
-  addPointsFromInputCloud();
+  bool addPointsFromInputCloud();
 
   /** \brief Split from the root while sigma_theta or sigma_phi > max_std_dev [rad]
    * and the node holds at least min_points_to_split points (eq. 4-5). */
-  void
-  computeAdaptiveLeaves(double max_std_dev, std::size_t min_points_to_split);
+  void computeAdaptiveLeaves(double max_std_dev, std::size_t min_points_to_split);
 
   /** \brief The leaves, in depth-first (Morton) order. */
-  const std::vector<AdaptiveLeaf>&
-  getAdaptiveLeaves() const
-  {
-    return leaves_;
-  }
+  const std::vector<AdaptiveLeaf>& getAdaptiveLeaves() const { return leaves_; }
 
   /** \brief Input point indices in depth-first order; each leaf owns a range. */
-  const pcl::Indices&
-  getOrderedIndices() const
-  {
-    return ordered_indices_;
-  }
+  const pcl::Indices& getOrderedIndices() const { return ordered_indices_; }
 
   /** \brief Edge length of a node at the given depth [m]. */
-  double
-  getVoxelSideLength(std::uint32_t depth) const;
+  double getVoxelSideLength(std::uint32_t depth) const;
 
   /** \brief Centre of a node [m], cloud frame. */
-  Eigen::Vector3f
-  getVoxelCentre(const AdaptiveLeaf& leaf) const;
+  Eigen::Vector3f getVoxelCentre(const AdaptiveLeaf& leaf) const;
 
 protected:
   using BranchNode = typename OctreeT::BranchNode;
@@ -125,27 +111,23 @@ protected:
     double sigma_phi = 0.0;
   };
 
-  bool
-  isValidPoint(pcl::index_t index) const;
+  bool isValidPoint(pcl::index_t index) const;
 
   /** \brief Order the points depth first; cache their normal angles. */
-  void
-  orderPoints(const pcl::octree::OctreeNode* node);
+  void orderPoints(const pcl::octree::OctreeNode* node);
 
   /** \brief eq. 4-6 over ordered points [begin, end). */
-  NodeStatistics
-  computeStatistics(std::size_t begin, std::size_t end) const;
+  NodeStatistics computeStatistics(std::size_t begin, std::size_t end) const;
 
   /** \brief First and one-past-last ordered point under a node. */
   std::pair<std::size_t, std::size_t>
   nodeRange(const pcl::octree::OctreeNode* node) const;
 
-  void
-  splitOrKeep(const pcl::octree::OctreeNode* node,
-              const pcl::octree::OctreeKey& key,
-              std::uint32_t depth,
-              double max_std_dev,
-              std::size_t min_points_to_split);
+  void splitOrKeep(const pcl::octree::OctreeNode* node,
+                   const pcl::octree::OctreeKey& key,
+                   std::uint32_t depth,
+                   double max_std_dev,
+                   std::size_t min_points_to_split);
 
 private:
   NormalCloudConstPtr normals_;
@@ -155,7 +137,7 @@ private:
   std::vector<Eigen::Vector3d> ordered_normals_; ///< sensor frame, reversed (eq. 5)
   std::vector<double> ordered_theta_;            ///< angles of ordered_normals_ [rad]
   std::vector<double> ordered_phi_;
-  std::vector<double> ordered_areas_;            ///< A_p
+  std::vector<double> ordered_areas_; ///< A_p
   std::vector<AdaptiveLeaf> leaves_;
 };
 

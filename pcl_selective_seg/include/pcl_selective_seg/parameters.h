@@ -71,8 +71,7 @@ struct PCL_EXPORTS SelectiveSegmentationParameters {
    * \param[out] why when invalid and non-null: which parameter, its value and its
    *             valid range.
    * \return true when all parameters are valid. */
-  bool
-  validate(std::string* why = nullptr) const;
+  bool validate(std::string* why = nullptr) const;
 };
 
 } // namespace selective_seg

@@ -20,10 +20,13 @@ namespace selective_seg {
 struct MergeInput {
   const Vector3fVector* leaf_normals = nullptr; ///< #L unit voxel normals N_v (eq. 4)
   const std::vector<double>* leaf_areas = nullptr; ///< #L voxel areas A_v (eq. 6) [m^2]
-  const std::vector<pcl::index_t>* vertex_leaf = nullptr; ///< #V leaf of each vertex, -1: none
-  const std::vector<Triangle>* triangles = nullptr;     ///< #T triangles over vertex ids
-  const Vector3fVector* triangle_normals = nullptr;     ///< #T unit normals, NaN if degenerate
-  /** #T optional: 1 for a triangle seen edge-on (a depth discontinuity), never valid. */
+  const std::vector<pcl::index_t>* vertex_leaf =
+      nullptr; ///< #V leaf of each vertex, -1: none
+  const std::vector<Triangle>* triangles = nullptr; ///< #T triangles over vertex ids
+  const Vector3fVector* triangle_normals =
+      nullptr; ///< #T unit normals, NaN if degenerate
+  /** #T optional: 1 for a triangle seen edge-on (a depth discontinuity), never valid.
+   */
   const std::vector<std::uint8_t>* triangle_edge_on = nullptr;
   double max_merge_angle = 0.0;         ///< eq. 9 threshold [rad]
   double max_edge_triangle_angle = 0.0; ///< eq. 8 threshold [rad]
@@ -33,29 +36,28 @@ struct MergeInput {
  *
  * Seeds are taken in a fixed order, largest first (by number of vertices, ties by leaf
  * index, i.e. octree position), so the result depends on the data only. An unassigned
- * seed starts a segment S_k, which grows breadth first: for every triangle at a vertex of
- * a seed of S_k that has a vertex outside S_k (an edge triangle) and whose normal is
- * within max_edge_triangle_angle of N_Sk (valid edge, eq. 8), each unassigned seed at its
- * vertices joins S_k when its normal is within max_merge_angle of N_Sk (eq. 9-10).
- * N_Sk is the normalized sum of N_v / A_v over its seeds (eq. 7), updated at every join.
- * Each seed joins once and each triangle is examined at most once per vertex: linear in
- * the mesh size.
+ * seed starts a segment S_k, which grows breadth first: for every triangle at a vertex
+ * of a seed of S_k that has a vertex outside S_k (an edge triangle) and whose normal is
+ * within max_edge_triangle_angle of N_Sk (valid edge, eq. 8), each unassigned seed at
+ * its vertices joins S_k when its normal is within max_merge_angle of N_Sk (eq. 9-10).
+ * N_Sk is the normalized sum of N_v / A_v over its seeds (eq. 7), updated at every
+ * join. Each seed joins once and each triangle is examined at most once per vertex:
+ * linear in the mesh size.
  *
  * \param[in] input the seeds and the mesh
  * \param[out] leaf_segment #L segment id of each seed, 0..#S-1 in creation order
  * \param[out] segment_normals #S unit segment normals N_S (eq. 7)
  */
-PCL_EXPORTS void
-mergeSeedSegments(const MergeInput& input,
-                  std::vector<pcl::index_t>& leaf_segment,
-                  Vector3fVector& segment_normals);
+PCL_EXPORTS void mergeSeedSegments(const MergeInput& input,
+                                   std::vector<pcl::index_t>& leaf_segment,
+                                   Vector3fVector& segment_normals);
 
 /** \brief Label and class of each triangle (eq. 8) from the final vertex labels.
  *
- * Interior: three vertices with one label. Otherwise the triangle takes the label, among
- * its vertices', whose segment normal is closest to its own normal, and is a valid edge
- * when that angle is at most max_edge_triangle_angle and it is not seen edge-on, an
- * invalid edge otherwise.
+ * Interior: three vertices with one label. Otherwise the triangle takes the label,
+ * among its vertices', whose segment normal is closest to its own normal, and is a
+ * valid edge when that angle is at most max_edge_triangle_angle and it is not seen
+ * edge-on, an invalid edge otherwise.
  *
  * \param[in] triangles #T triangles over vertex ids
  * \param[in] triangle_normals #T unit normals (NaN: degenerate, never a valid edge)
@@ -66,15 +68,14 @@ mergeSeedSegments(const MergeInput& input,
  * \param[out] labels #T labels (0 when no vertex is labeled)
  * \param[out] classes #T classes
  */
-PCL_EXPORTS void
-classifyTriangles(const std::vector<Triangle>& triangles,
-                  const Vector3fVector& triangle_normals,
-                  const std::vector<std::uint8_t>* triangle_edge_on,
-                  const std::vector<std::uint32_t>& vertex_labels,
-                  const Vector3fVector& label_normals,
-                  double max_edge_triangle_angle,
-                  std::vector<std::uint32_t>& labels,
-                  std::vector<TriangleClass>& classes);
+PCL_EXPORTS void classifyTriangles(const std::vector<Triangle>& triangles,
+                                   const Vector3fVector& triangle_normals,
+                                   const std::vector<std::uint8_t>* triangle_edge_on,
+                                   const std::vector<std::uint32_t>& vertex_labels,
+                                   const Vector3fVector& label_normals,
+                                   double max_edge_triangle_angle,
+                                   std::vector<std::uint32_t>& labels,
+                                   std::vector<TriangleClass>& classes);
 
 /** \brief Compressed incidence lists: the items of group g are
  * items[offsets[g] .. offsets[g + 1]), in increasing item order.
@@ -84,13 +85,13 @@ struct PCL_EXPORTS Incidence {
   std::vector<std::size_t> offsets;
   std::vector<pcl::index_t> items;
 
-  static Incidence
-  build(const std::vector<pcl::index_t>& group_of, std::size_t num_groups);
+  static Incidence build(const std::vector<pcl::index_t>& group_of,
+                         std::size_t num_groups);
 };
 
 /** \brief Triangles at each vertex, in increasing triangle order. */
-PCL_EXPORTS Incidence
-vertexTriangles(const std::vector<Triangle>& triangles, std::size_t num_vertices);
+PCL_EXPORTS Incidence vertexTriangles(const std::vector<Triangle>& triangles,
+                                      std::size_t num_vertices);
 
 } // namespace selective_seg
 } // namespace pcl

@@ -33,11 +33,12 @@ enum class TriangleClass : std::uint8_t {
 
 /** \brief Wall-clock time of each stage [s], the columns of the paper's Table I. */
 struct StageTimings {
-  double delaunay = 0.0; ///< spherical projection, quantization, triangulation, adjacency
-  double normals = 0.0;  ///< triangle normals and areas, point normals (eq. 2, 3)
-  double octree = 0.0;   ///< octree build and adaptive subdivision (eq. 4, 5)
-  double merge = 0.0;    ///< seed merging (eq. 6-10) and output labels
-  double total = 0.0;    ///< the whole extract() call
+  double delaunay =
+      0.0; ///< spherical projection, quantization, triangulation, adjacency
+  double normals = 0.0; ///< triangle normals and areas, point normals (eq. 2, 3)
+  double octree = 0.0;  ///< octree build and adaptive subdivision (eq. 4, 5)
+  double merge = 0.0;   ///< seed merging (eq. 6-10) and output labels
+  double total = 0.0;   ///< the whole extract() call
 };
 
 /** \brief What happened to the input points. Every input point is counted once in
@@ -56,22 +57,22 @@ struct PointCounts {
 struct OctreeLeaf {
   /** Voxel centre, cloud frame [m]. The voxel's axes are the sensor's axes. */
   Eigen::Vector3f centre = Eigen::Vector3f::Zero();
-  float size = 0.0f;            ///< voxel edge length [m]
-  std::uint32_t depth = 0;      ///< depth in the octree (root = 0)
-  std::uint32_t label = 0;      ///< segment label of its points
+  float size = 0.0f;                                ///< voxel edge length [m]
+  std::uint32_t depth = 0;                          ///< depth in the octree (root = 0)
+  std::uint32_t label = 0;                          ///< segment label of its points
   Eigen::Vector3f normal = Eigen::Vector3f::Zero(); ///< N_v (eq. 4), toward the sensor
-  float sigma_theta = 0.0f;     ///< sigma_v,theta (eq. 5) [rad]
-  float sigma_phi = 0.0f;       ///< sigma_v,phi (eq. 5) [rad]
-  double area = 0.0;            ///< A_v (eq. 6) [m^2]
-  std::uint32_t num_points = 0; ///< mesh vertices in the leaf
+  float sigma_theta = 0.0f;                         ///< sigma_v,theta (eq. 5) [rad]
+  float sigma_phi = 0.0f;                           ///< sigma_v,phi (eq. 5) [rad]
+  double area = 0.0;                                ///< A_v (eq. 6) [m^2]
+  std::uint32_t num_points = 0;                     ///< mesh vertices in the leaf
 };
 
 /** \brief A segment of the result. */
 struct Segment {
-  std::uint32_t label = 0;  ///< label >= 1; labels are ranked by size, largest first
+  std::uint32_t label = 0;    ///< label >= 1; labels are ranked by size, largest first
   std::size_t num_points = 0; ///< input points with this label
   Eigen::Vector3f normal = Eigen::Vector3f::Zero(); ///< N_S (eq. 7), toward the sensor
-  double area = 0.0;        ///< sum of A_v over its leaves [m^2]
+  double area = 0.0;          ///< sum of A_v over its leaves [m^2]
   std::size_t num_leaves = 0; ///< octree leaves merged into it
 };
 
@@ -82,31 +83,27 @@ struct SegmentedMesh {
   std::vector<Triangle> triangles;
   /** Triangle across the edge opposite each vertex, -1 on the mesh boundary. */
   std::vector<Triangle> neighbours;
-  std::vector<std::uint32_t> labels;   ///< per triangle: a segment label, 0 = none
-  std::vector<TriangleClass> classes;  ///< per triangle, eq. 8
+  std::vector<std::uint32_t> labels;  ///< per triangle: a segment label, 0 = none
+  std::vector<TriangleClass> classes; ///< per triangle, eq. 8
   /** Unit normal per triangle, cloud frame, toward the sensor; NaN when degenerate. */
   std::vector<Eigen::Vector3f> normals;
-  std::vector<double> areas;           ///< 3-D area per triangle [m^2]
+  std::vector<double> areas; ///< 3-D area per triangle [m^2]
 };
 
 /** \brief Everything SelectiveSegmentation::extract() computes besides the clouds. */
 struct SegmentationResult {
   /** One label per input point (input order), 0 = unlabeled. */
   std::vector<std::uint32_t> labels;
-  std::vector<Segment> segments; ///< ordered by label: segments[i].label == i + 1
+  std::vector<Segment> segments;  ///< ordered by label: segments[i].label == i + 1
   std::vector<OctreeLeaf> leaves; ///< the labeled multi-resolution octree leaves
   SegmentedMesh mesh;
   PointCounts counts;
   StageTimings timings;
-  std::size_t num_vertices = 0;   ///< mesh vertices (distinct quantized angles)
-  double min_voxel_size = 0.0;    ///< the octree's finest voxel edge actually used [m]
-  double median_spacing = 0.0;    ///< median 3-D edge length of the mesh [m]
+  std::size_t num_vertices = 0; ///< mesh vertices (distinct quantized angles)
+  double min_voxel_size = 0.0;  ///< the octree's finest voxel edge actually used [m]
+  double median_spacing = 0.0;  ///< median 3-D edge length of the mesh [m]
 
-  void
-  clear()
-  {
-    *this = SegmentationResult();
-  }
+  void clear() { *this = SegmentationResult(); }
 };
 
 } // namespace selective_seg

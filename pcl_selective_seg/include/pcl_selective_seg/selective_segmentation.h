@@ -36,22 +36,21 @@ namespace selective_seg {
  * Usage, as any PCL segmentation:
  * \code
  * pcl::selective_seg::SelectiveSegmentation<pcl::PointXYZ> seg;
- * seg.setInputCloud(cloud);            // sensor pose: cloud->sensor_origin_/orientation_
- * std::vector<pcl::PointIndices> segments;
- * if (seg.extract(segments))           // largest first
- *   auto labeled = seg.getLabeledCloud();
- * \endcode
+ * seg.setInputCloud(cloud);            // sensor pose:
+ * cloud->sensor_origin_/orientation_ std::vector<pcl::PointIndices> segments; if
+ * (seg.extract(segments))           // largest first auto labeled =
+ * seg.getLabeledCloud(); \endcode
  *
- * Points outside the indices, with non-finite coordinates, at or behind the sensor plane
- * or without a normal get label 0 and are counted in getResult().counts. The result
- * depends on the point set only, not on the order of the points.
+ * Points outside the indices, with non-finite coordinates, at or behind the sensor
+ * plane or without a normal get label 0 and are counted in getResult().counts. The
+ * result depends on the point set only, not on the order of the points.
  *
- * Every stage works in the sensor frame, the paper's frame, so the segmentation does not
- * depend on where the sensor stood in the world; normals, leaf centres and the mesh are
- * reported in the cloud frame. The octree's voxels are aligned with the sensor axes.
+ * Every stage works in the sensor frame, the paper's frame, so the segmentation does
+ * not depend on where the sensor stood in the world; normals, leaf centres and the mesh
+ * are reported in the cloud frame. The octree's voxels are aligned with the sensor
+ * axes.
  */
-template <typename PointT>
-class SelectiveSegmentation : public pcl::PCLBase<PointT> {
+template <typename PointT> class SelectiveSegmentation : public pcl::PCLBase<PointT> {
 public:
   using Ptr = pcl::shared_ptr<SelectiveSegmentation<PointT>>;
   using ConstPtr = pcl::shared_ptr<const SelectiveSegmentation<PointT>>;
@@ -64,206 +63,126 @@ public:
   SelectiveSegmentation() = default;
 
   /** \brief All parameters at once (checked by extract()). */
-  void
-  setParameters(const SelectiveSegmentationParameters& parameters)
+  void setParameters(const SelectiveSegmentationParameters& parameters)
   {
     params_ = parameters;
   }
-  const SelectiveSegmentationParameters&
-  getParameters() const
-  {
-    return params_;
-  }
+  const SelectiveSegmentationParameters& getParameters() const { return params_; }
 
   /** \brief Octree split threshold on the normal angles' standard deviation [rad]. */
-  void
-  setMaxNormalStdDev(double angle)
-  {
-    params_.max_normal_std_dev = angle;
-  }
-  double
-  getMaxNormalStdDev() const
-  {
-    return params_.max_normal_std_dev;
-  }
+  void setMaxNormalStdDev(double angle) { params_.max_normal_std_dev = angle; }
+  double getMaxNormalStdDev() const { return params_.max_normal_std_dev; }
 
   /** \brief Largest angle between segment normals that still merge (eq. 9) [rad]. */
-  void
-  setMaxMergeAngle(double angle)
-  {
-    params_.max_merge_angle = angle;
-  }
-  double
-  getMaxMergeAngle() const
-  {
-    return params_.max_merge_angle;
-  }
+  void setMaxMergeAngle(double angle) { params_.max_merge_angle = angle; }
+  double getMaxMergeAngle() const { return params_.max_merge_angle; }
 
   /** \brief Largest angle between an edge triangle and a segment for the triangle to
    * be searched (eq. 8) [rad]. */
-  void
-  setMaxEdgeTriangleAngle(double angle)
+  void setMaxEdgeTriangleAngle(double angle)
   {
     params_.max_edge_triangle_angle = angle;
   }
-  double
-  getMaxEdgeTriangleAngle() const
-  {
-    return params_.max_edge_triangle_angle;
-  }
+  double getMaxEdgeTriangleAngle() const { return params_.max_edge_triangle_angle; }
 
   /** \brief Most oblique view of an edge triangle that still counts as surface [rad];
    * pi/2 (the paper) disables the test. */
-  void
-  setMaxViewIncidenceAngle(double angle)
+  void setMaxViewIncidenceAngle(double angle)
   {
     params_.max_view_incidence_angle = angle;
   }
-  double
-  getMaxViewIncidenceAngle() const
-  {
-    return params_.max_view_incidence_angle;
-  }
+  double getMaxViewIncidenceAngle() const { return params_.max_view_incidence_angle; }
 
   /** \brief Smallest voxel edge [m]; 0 = automatic (see the parameters). */
-  void
-  setMinVoxelSize(double size)
-  {
-    params_.min_voxel_size = size;
-  }
-  double
-  getMinVoxelSize() const
-  {
-    return params_.min_voxel_size;
-  }
+  void setMinVoxelSize(double size) { params_.min_voxel_size = size; }
+  double getMinVoxelSize() const { return params_.min_voxel_size; }
 
   /** \brief Triangulation backend. */
-  void
-  setDelaunayBackend(DelaunayBackend backend)
+  void setDelaunayBackend(DelaunayBackend backend)
   {
     params_.delaunay_backend = backend;
   }
-  DelaunayBackend
-  getDelaunayBackend() const
-  {
-    return params_.delaunay_backend;
-  }
+  DelaunayBackend getDelaunayBackend() const { return params_.delaunay_backend; }
 
   /** \brief Sensor pose in the cloud frame (the sensor looks along its +z axis),
    * overriding the cloud's sensor_origin_ / sensor_orientation_. */
-  void
-  setSensorPose(const Eigen::Affine3f& sensor_to_cloud)
+  void setSensorPose(const Eigen::Affine3f& sensor_to_cloud)
   {
     delaunay_.setSensorPose(sensor_to_cloud);
   }
   /** \brief Use the input cloud's sensor_origin_ / sensor_orientation_ again. */
-  void
-  resetSensorPose()
-  {
-    delaunay_.resetSensorPose();
-  }
+  void resetSensorPose() { delaunay_.resetSensorPose(); }
 
   /** \brief Run the whole pipeline.
    * \param[out] clusters the segments' point indices, largest first (segment i has
    *             label i + 1)
    * \return false, with a PCL_ERROR saying why and empty outputs, on a missing or
    *         unusable input or an invalid parameter. */
-  bool
-  extract(std::vector<pcl::PointIndices>& clusters);
+  bool extract(std::vector<pcl::PointIndices>& clusters);
 
-  /** \brief Labels, segments, leaves, mesh, counts and timings of the last extract(). */
-  const SegmentationResult&
-  getResult() const
-  {
-    return result_;
-  }
+  /** \brief Labels, segments, leaves, mesh, counts and timings of the last extract().
+   */
+  const SegmentationResult& getResult() const { return result_; }
 
   /** \brief The input's points with their labels (0 = unlabeled); same size, order
    * and layout (width, height) as the input. Null before a successful extract(). */
-  LabeledCloud::Ptr
-  getLabeledCloud() const;
+  LabeledCloud::Ptr getLabeledCloud() const;
 
   /** \brief Point normals (eq. 2) in the cloud frame, oriented toward the sensor; same
    * size and layout as the input; NaN where a point has no normal. */
-  NormalCloud::ConstPtr
-  getPointNormals() const
-  {
-    return normals_;
-  }
+  NormalCloud::ConstPtr getPointNormals() const { return normals_; }
 
   /** \brief The segmented mesh over the input cloud (labels and classes per triangle
    * are in getResult().mesh). */
-  void
-  getPolygonMesh(pcl::PolygonMesh& mesh) const;
+  void getPolygonMesh(pcl::PolygonMesh& mesh) const;
 
   /** \brief The triangulation of the last extract(): the vertex of every input point,
    * the vertices' representative points, angles and sensor-frame positions. */
-  const SphericalTriangulation&
-  getTriangulation() const
+  const SphericalTriangulation& getTriangulation() const
   {
     return delaunay_.getTriangulation();
   }
 
-  /** \brief The multi-resolution octree of the last extract(), over the mesh vertices in
-   * the sensor frame (its point i is vertex i of getTriangulation()). */
-  typename Octree::ConstPtr
-  getOctree() const
-  {
-    return octree_;
-  }
+  /** \brief The multi-resolution octree of the last extract(), over the mesh vertices
+   * in the sensor frame (its point i is vertex i of getTriangulation()). */
+  typename Octree::ConstPtr getOctree() const { return octree_; }
 
 protected:
   using pcl::PCLBase<PointT>::input_;
   using pcl::PCLBase<PointT>::indices_;
 
   /** \brief The base checks plus parameters and indices. */
-  bool
-  initCompute();
+  bool initCompute();
 
-  std::string
-  getClassName() const
-  {
-    return "SelectiveSegmentation";
-  }
+  std::string getClassName() const { return "SelectiveSegmentation"; }
 
   /** \brief Stage 1-2: spherical projection and Delaunay triangulation. */
-  bool
-  triangulate();
+  bool triangulate();
 
   /** \brief Stage 3: triangle and point normals and areas (eq. 2-3). */
-  bool
-  computeNormals();
+  bool computeNormals();
 
   /** \brief Stage 4: the multi-resolution octree (eq. 4-5). */
-  bool
-  buildOctree();
+  bool buildOctree();
 
   /** \brief Stage 5: seed merging (eq. 6-10) and the labeled outputs. */
-  void
-  mergeAndLabel();
+  void mergeAndLabel();
 
   /** \brief Labels ranked by segment size, per-point labels, segments and clusters. */
-  void
-  rankSegments(const std::vector<pcl::index_t>& vertex_segment,
-               const Vector3fVector& segment_normals,
-               std::vector<std::uint32_t>& segment_label);
+  void rankSegments(const std::vector<pcl::index_t>& vertex_segment,
+                    const Vector3fVector& segment_normals,
+                    std::vector<std::uint32_t>& segment_label);
 
   /** \brief Rotation from the sensor frame to the cloud frame. */
-  Eigen::Matrix3f
-  sensorToCloud() const
-  {
-    return delaunay_.getSensorPose().rotation();
-  }
+  Eigen::Matrix3f sensorToCloud() const { return delaunay_.getSensorPose().rotation(); }
 
   /** \brief Mesh, leaves and counts of the result from the final labels. */
-  void
-  fillMeshAndLeaves(const std::vector<std::uint32_t>& vertex_labels,
-                    const std::vector<pcl::index_t>& leaf_segment,
-                    const std::vector<std::uint32_t>& segment_label);
+  void fillMeshAndLeaves(const std::vector<std::uint32_t>& vertex_labels,
+                         const std::vector<pcl::index_t>& leaf_segment,
+                         const std::vector<std::uint32_t>& segment_label);
 
   /** \brief Fail: report, clear the outputs, keep the point counts. */
-  bool
-  fail(const char* stage, const std::string& why);
+  bool fail(const char* stage, const std::string& why);
 
 private:
   SelectiveSegmentationParameters params_;

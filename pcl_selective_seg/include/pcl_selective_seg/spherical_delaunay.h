@@ -16,14 +16,16 @@
 namespace pcl {
 namespace selective_seg {
 
-/** \brief Why a point has no mesh vertex (values of SphericalTriangulation::point_vertex). */
+/** \brief Why a point has no mesh vertex (values of
+ * SphericalTriangulation::point_vertex). */
 enum PointStatus : pcl::index_t {
   kOutsideIndices = -1, ///< not in the indices
   kNonFinite = -2,      ///< NaN or Inf coordinate
   kBehindSensor = -3    ///< z <= 0 in the sensor frame
 };
 
-/** \brief The triangulation of a cloud in spherical space (paper, eq. 1 and Sec. III.A).
+/** \brief The triangulation of a cloud in spherical space (paper, eq. 1 and Sec.
+ * III.A).
  *
  * Mesh vertices are the distinct quantized angle pairs, numbered in increasing
  * (theta, phi) order, so the numbering depends on the point set only. */
@@ -47,7 +49,8 @@ struct SphericalTriangulation {
   double angle_quantization = 0.0; ///< [rad]
 };
 
-/** \brief Delaunay triangulation of a cloud in the sensor's spherical space (theta, phi).
+/** \brief Delaunay triangulation of a cloud in the sensor's spherical space (theta,
+ * phi).
  *
  * Points are mapped to the sensor frame (the cloud's sensor_origin_ and
  * sensor_orientation_ unless setSensorPose() overrides them), then to theta =
@@ -58,8 +61,8 @@ struct SphericalTriangulation {
  * Points that are not finite or lie at or behind the sensor plane (z <= 0) get no
  * vertex. Points with equal quantized angles share one vertex.
  *
- * Use it as any pcl::MeshConstruction: reconstruct(pcl::PolygonMesh&) gives the mesh over
- * the input cloud; getTriangulation() the vertex map and triangle adjacency.
+ * Use it as any pcl::MeshConstruction: reconstruct(pcl::PolygonMesh&) gives the mesh
+ * over the input cloud; getTriangulation() the vertex map and triangle adjacency.
  */
 template <typename PointT>
 class SphericalDelaunay : public pcl::MeshConstruction<PointT> {
@@ -72,89 +75,52 @@ public:
   SphericalDelaunay() { this->check_tree_ = false; }
 
   /** \brief Triangulation backend (default: DelaunayBackend::BoostVoronoi). */
-  void
-  setBackend(DelaunayBackend backend)
-  {
-    backend_ = backend;
-  }
-  DelaunayBackend
-  getBackend() const
-  {
-    return backend_;
-  }
+  void setBackend(DelaunayBackend backend) { backend_ = backend; }
+  DelaunayBackend getBackend() const { return backend_; }
 
   /** \brief Grid step of the angle quantization [rad], in [2.5e-8, 1e-2]. */
-  void
-  setAngleQuantization(double step)
-  {
-    angle_quantization_ = step;
-  }
-  double
-  getAngleQuantization() const
-  {
-    return angle_quantization_;
-  }
+  void setAngleQuantization(double step) { angle_quantization_ = step; }
+  double getAngleQuantization() const { return angle_quantization_; }
 
   /** \brief Sensor pose in the cloud frame, overriding the cloud's sensor_origin_ /
    * sensor_orientation_. The sensor looks along its +z axis. */
-  void
-  setSensorPose(const Eigen::Affine3f& sensor_to_cloud)
+  void setSensorPose(const Eigen::Affine3f& sensor_to_cloud)
   {
     sensor_pose_ = sensor_to_cloud;
     has_sensor_pose_ = true;
   }
   /** \brief Use the cloud's own sensor_origin_ / sensor_orientation_ again. */
-  void
-  resetSensorPose()
-  {
-    has_sensor_pose_ = false;
-  }
+  void resetSensorPose() { has_sensor_pose_ = false; }
   /** \brief The pose in use: the override, or the input cloud's (identity if none). */
-  Eigen::Affine3f
-  getSensorPose() const;
+  Eigen::Affine3f getSensorPose() const;
 
   /** \brief Guarded: the base class dereferences a missing input. */
-  void
-  reconstruct(pcl::PolygonMesh& output) override;
+  void reconstruct(pcl::PolygonMesh& output) override;
 
   /** \brief Project, quantize and triangulate; getTriangulation() gives the result.
    * \return false (with a PCL_ERROR saying why) on a missing input, a bad parameter or
    *         a backend failure. Fewer than three distinct non-collinear positions is not
    *         a failure: the result then has no triangle. */
-  bool
-  triangulate();
+  bool triangulate();
 
   /** \brief The triangulation of the last reconstruct() or triangulate() call. */
-  const SphericalTriangulation&
-  getTriangulation() const
-  {
-    return triangulation_;
-  }
+  const SphericalTriangulation& getTriangulation() const { return triangulation_; }
 
 protected:
-  std::string
-  getClassName() const override
-  {
-    return "SphericalDelaunay";
-  }
+  std::string getClassName() const override { return "SphericalDelaunay"; }
 
-  void
-  performReconstruction(pcl::PolygonMesh& output) override;
+  void performReconstruction(pcl::PolygonMesh& output) override;
 
-  void
-  performReconstruction(std::vector<pcl::Vertices>& polygons) override;
+  void performReconstruction(std::vector<pcl::Vertices>& polygons) override;
 
   /** \brief Stage 1: angles of every input point in indices_, and the vertex map. */
-  void
-  projectAndMergeVertices(SphericalTriangulation& result) const;
+  void projectAndMergeVertices(SphericalTriangulation& result) const;
 
   /** \brief Triangulate the vertices of triangulation_ (stage 2). */
-  bool
-  triangulateVertices();
+  bool triangulateVertices();
 
   /** \brief The triangles as polygons over input point indices. */
-  void
-  toPolygons(std::vector<pcl::Vertices>& polygons) const;
+  void toPolygons(std::vector<pcl::Vertices>& polygons) const;
 
 private:
   DelaunayBackend backend_ = DelaunayBackend::BoostVoronoi;

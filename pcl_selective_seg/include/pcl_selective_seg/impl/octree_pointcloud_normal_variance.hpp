@@ -34,14 +34,16 @@ wrapAngle(double a)
 } // namespace detail
 
 template <typename PointT>
-OctreePointCloudNormalVariance<PointT>::OctreePointCloudNormalVariance(double resolution)
-: OctreeT(resolution)
-{}
+OctreePointCloudNormalVariance<PointT>::OctreePointCloudNormalVariance(
+    double resolution)
+    : OctreeT(resolution)
+{
+}
 
 template <typename PointT>
 void
-OctreePointCloudNormalVariance<PointT>::setInputNormals(const NormalCloudConstPtr& normals,
-                                                        const AreasConstPtr& areas)
+OctreePointCloudNormalVariance<PointT>::setInputNormals(
+    const NormalCloudConstPtr& normals, const AreasConstPtr& areas)
 {
   normals_ = normals;
   areas_ = areas;
@@ -81,7 +83,8 @@ OctreePointCloudNormalVariance<PointT>::addPointsFromInputCloud()
   Eigen::Array3d lo = Eigen::Array3d::Constant(std::numeric_limits<double>::max());
   Eigen::Array3d hi = -lo;
   for (const auto i : valid) {
-    const Eigen::Array3d p = (*this->input_)[i].getVector3fMap().template cast<double>();
+    const Eigen::Array3d p =
+        (*this->input_)[i].getVector3fMap().template cast<double>();
     lo = lo.min(p);
     hi = hi.max(p);
   }
@@ -98,8 +101,8 @@ void
 OctreePointCloudNormalVariance<PointT>::orderPoints(const pcl::octree::OctreeNode* node)
 {
   if (node->getNodeType() == pcl::octree::LEAF_NODE) {
-    auto& container = const_cast<LeafNode*>(static_cast<const LeafNode*>(node))
-                          ->getContainer();
+    auto& container =
+        const_cast<LeafNode*>(static_cast<const LeafNode*>(node))->getContainer();
     container.setFirstOrderedPoint(ordered_indices_.size());
     const Eigen::Matrix3d to_sensor =
         sensor_orientation_.toRotationMatrix().transpose().template cast<double>();
@@ -123,7 +126,8 @@ OctreePointCloudNormalVariance<PointT>::orderPoints(const pcl::octree::OctreeNod
 
 template <typename PointT>
 std::pair<std::size_t, std::size_t>
-OctreePointCloudNormalVariance<PointT>::nodeRange(const pcl::octree::OctreeNode* node) const
+OctreePointCloudNormalVariance<PointT>::nodeRange(
+    const pcl::octree::OctreeNode* node) const
 {
   const auto* first = node;
   while (first->getNodeType() == pcl::octree::BRANCH_NODE) {
@@ -206,7 +210,8 @@ OctreePointCloudNormalVariance<PointT>::splitOrKeep(const pcl::octree::OctreeNod
   leaf.end = range.second;
   const Eigen::Matrix3d to_cloud =
       sensor_orientation_.toRotationMatrix().template cast<double>();
-  leaf.normal = (-(to_cloud * s.sum_weighted_normal)).normalized().template cast<float>();
+  leaf.normal =
+      (-(to_cloud * s.sum_weighted_normal)).normalized().template cast<float>();
   leaf.area = s.sum_area;
   leaf.sigma_theta = static_cast<float>(s.sigma_theta);
   leaf.sigma_phi = static_cast<float>(s.sigma_phi);
@@ -226,7 +231,8 @@ OctreePointCloudNormalVariance<PointT>::computeAdaptiveLeaves(
   ordered_areas_.clear();
   if (this->leaf_count_ == 0 || !this->root_node_)
     return;
-  ordered_indices_.reserve(this->indices_ ? this->indices_->size() : this->input_->size());
+  ordered_indices_.reserve(this->indices_ ? this->indices_->size()
+                                          : this->input_->size());
   orderPoints(this->root_node_);
   splitOrKeep(this->root_node_,
               pcl::octree::OctreeKey(),
@@ -240,7 +246,8 @@ double
 OctreePointCloudNormalVariance<PointT>::getVoxelSideLength(std::uint32_t depth) const
 {
   return this->resolution_ *
-         static_cast<double>(1ULL << (this->octree_depth_ - std::min(depth, this->octree_depth_)));
+         static_cast<double>(
+             1ULL << (this->octree_depth_ - std::min(depth, this->octree_depth_)));
 }
 
 template <typename PointT>

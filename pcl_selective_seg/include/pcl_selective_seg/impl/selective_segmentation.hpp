@@ -36,7 +36,8 @@ SelectiveSegmentation<PointT>::initCompute()
     return false;
   std::string why;
   if (!params_.validate(&why)) {
-    PCL_ERROR("[pcl::selective_seg::%s::extract] %s\n", getClassName().c_str(), why.c_str());
+    PCL_ERROR(
+        "[pcl::selective_seg::%s::extract] %s\n", getClassName().c_str(), why.c_str());
     return false;
   }
   return true;
@@ -46,7 +47,8 @@ template <typename PointT>
 bool
 SelectiveSegmentation<PointT>::fail(const char* stage, const std::string& why)
 {
-  PCL_ERROR("[pcl::selective_seg::%s::%s] %s\n", getClassName().c_str(), stage, why.c_str());
+  PCL_ERROR(
+      "[pcl::selective_seg::%s::%s] %s\n", getClassName().c_str(), stage, why.c_str());
   const PointCounts counts = result_.counts;
   result_.clear();
   result_.counts = counts;
@@ -182,9 +184,10 @@ SelectiveSegmentation<PointT>::buildOctree()
 
 template <typename PointT>
 void
-SelectiveSegmentation<PointT>::rankSegments(const std::vector<pcl::index_t>& vertex_segment,
-                                            const Vector3fVector& segment_normals,
-                                            std::vector<std::uint32_t>& segment_label)
+SelectiveSegmentation<PointT>::rankSegments(
+    const std::vector<pcl::index_t>& vertex_segment,
+    const Vector3fVector& segment_normals,
+    std::vector<std::uint32_t>& segment_label)
 {
   const SphericalTriangulation& tri = delaunay_.getTriangulation();
   const std::size_t num_segments = segment_normals.size();
@@ -349,7 +352,8 @@ SelectiveSegmentation<PointT>::extract(std::vector<pcl::PointIndices>& clusters)
     c.header = input_->header;
   result_.timings.merge = watch.getTimeSeconds();
   if (result_.segments.empty())
-    PCL_WARN("[pcl::selective_seg::%s::extract] no segment found\n", getClassName().c_str());
+    PCL_WARN("[pcl::selective_seg::%s::extract] no segment found\n",
+             getClassName().c_str());
   this->deinitCompute();
   result_.timings.total = total.getTimeSeconds();
   return true;
@@ -393,5 +397,5 @@ SelectiveSegmentation<PointT>::getPolygonMesh(pcl::PolygonMesh& mesh) const
 } // namespace selective_seg
 } // namespace pcl
 
-#define PCL_INSTANTIATE_SelectiveSegmentation(T)                                      \
+#define PCL_INSTANTIATE_SelectiveSegmentation(T)                                       \
   template class PCL_EXPORTS pcl::selective_seg::SelectiveSegmentation<T>;

@@ -27,11 +27,11 @@ struct ProjectedPoint {
   Eigen::Vector3f sensor_xyz;
   pcl::index_t index;
 
-  bool
-  operator<(const ProjectedPoint& o) const
+  bool operator<(const ProjectedPoint& o) const
   {
     return std::tie(angles, range_squared, xyz.x(), xyz.y(), xyz.z(), index) <
-           std::tie(o.angles, o.range_squared, o.xyz.x(), o.xyz.y(), o.xyz.z(), o.index);
+           std::tie(
+               o.angles, o.range_squared, o.xyz.x(), o.xyz.y(), o.xyz.z(), o.index);
   }
 };
 
@@ -75,9 +75,10 @@ SphericalDelaunay<PointT>::projectAndMergeVertices(SphericalTriangulation& resul
       continue;
     }
     // eq. 1; both angles lie in (-pi/2, pi/2) because z > 0.
-    const QuantizedPoint q{
-        static_cast<std::int32_t>(std::lround(std::atan2(s.x(), s.z()) / angle_quantization_)),
-        static_cast<std::int32_t>(std::lround(std::atan2(s.y(), s.z()) / angle_quantization_))};
+    const QuantizedPoint q{static_cast<std::int32_t>(std::lround(
+                               std::atan2(s.x(), s.z()) / angle_quantization_)),
+                           static_cast<std::int32_t>(std::lround(
+                               std::atan2(s.y(), s.z()) / angle_quantization_))};
     projected.push_back({q, s.squaredNorm(), p.getVector3fMap(), s.cast<float>(), i});
   }
   std::sort(projected.begin(), projected.end());
@@ -106,7 +107,8 @@ bool
 SphericalDelaunay<PointT>::triangulateVertices()
 {
   std::string why;
-  if (!delaunay2d(triangulation_.vertex_angles, backend_, triangulation_.triangles, &why)) {
+  if (!delaunay2d(
+          triangulation_.vertex_angles, backend_, triangulation_.triangles, &why)) {
     PCL_ERROR("[pcl::selective_seg::%s::triangulate] %s\n",
               getClassName().c_str(),
               why.c_str());
@@ -143,10 +145,11 @@ SphericalDelaunay<PointT>::triangulate()
                                      this->indices_->end(),
                                      [n](pcl::index_t i) { return i < 0 || i >= n; });
   if (bad_index) {
-    PCL_ERROR("[pcl::selective_seg::%s::triangulate] an index lies outside the cloud of "
-              "%d points\n",
-              getClassName().c_str(),
-              static_cast<int>(n));
+    PCL_ERROR(
+        "[pcl::selective_seg::%s::triangulate] an index lies outside the cloud of "
+        "%d points\n",
+        getClassName().c_str(),
+        static_cast<int>(n));
     this->deinitCompute();
     return false;
   }
@@ -205,5 +208,5 @@ SphericalDelaunay<PointT>::performReconstruction(std::vector<pcl::Vertices>& pol
 } // namespace selective_seg
 } // namespace pcl
 
-#define PCL_INSTANTIATE_SphericalDelaunay(T)                                          \
+#define PCL_INSTANTIATE_SphericalDelaunay(T)                                           \
   template class PCL_EXPORTS pcl::selective_seg::SphericalDelaunay<T>;

@@ -1,0 +1,379 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
+ *
+ *  Unit tests of the triangle and point normals (paper, Sec. III.B, eq. 2-3).
+ */
+
+#include <pcl_selective_seg/mesh_normals.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <vector>
+
+using pcl::selective_seg::computeTriangleNormals;
+using pcl::selective_seg::computeVertexNormals;
+using pcl::selective_seg::markEdgeOnTriangles;
+using pcl::selective_seg::medianEdgeLength;
+using pcl::selective_seg::Triangle;
+using pcl::selective_seg::Vector3fVector;
+
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+const float kNaN = std::numeric_limits<float>::quiet_NaN();
+
+void
+expectVectorNear(const Eigen::Vector3f& actual,
+                 const Eigen::Vector3f& expected,
+                 float tolerance = 1e-6f)
+{
+  EXPECT_NEAR(actual.x(), expected.x(), tolerance);
+  EXPECT_NEAR(actual.y(), expected.y(), tolerance);
+  EXPECT_NEAR(actual.z(), expected.z(), tolerance);
+}
+
+/** Three vertices around \a centre in the plane through it with unit normal \a normal,
+ * at distance \a radius, 120 degrees apart: their centroid is \a centre. */
+Vector3fVector
+equilateralAround(const Eigen::Vector3d& centre,
+                  const Eigen::Vector3d& normal,
+                  double radius)
+{
+  const Eigen::Vector3d u = normal.unitOrthogonal();
+  const Eigen::Vector3d w = normal.cross(u);
+  Vector3fVector vertices;
+  for (int k = 0; k < 3; ++k) {
+    const double a = k * 2.0 * M_PI / 3.0;
+    vertices.push_back(
+        (centre + radius * (std::cos(a) * u + std::sin(a) * w)).cast<float>());
+  }
+  return vertices;
+}
+
+} // namespace
+
+TEST(MeshNormals, RightTriangleNormalAndArea)
+{
+  // Legs 3 and 4 in the plane z = 5: area 3 * 4 / 2 = 6, normal -z toward the origin.
+  const Vector3fVector positions{{0.f, 0.f, 5.f}, {3.f, 0.f, 5.f}, {0.f, 4.f, 5.f}};
+  const std::vector<Triangle> triangles{{0, 1, 2}, {0, 2, 1}, {2, 1, 0}};
+  Vector3fVector normals;
+  std::vector<double> areas;
+  computeTriangleNormals(positions, triangles, Eigen::Vector3f::Zero(), normals, areas);
+  ASSERT_EQ(normals.size(), 3u);
+  ASSERT_EQ(areas.size(), 3u);
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    SCOPED_TRACE(t);
+    EXPECT_NEAR(areas[t], 6.0, 1e-12);
+    expectVectorNear(normals[t], Eigen::Vector3f(0.f, 0.f, -1.f));
+  }
+}
+
+TEST(MeshNormals, TiltedRightTriangle)
+{
+  // Legs 3 along x and 4 along (0, 1, 1) / sqrt 2 from a = (1, 1, 5). The plane's
+  // normal is x cross (0, 1, 1) / sqrt 2 = (0, -1, 1) / sqrt 2; the centroid is at
+  // z > 5 and y > 1 with z - y > 0, so the normal facing the origin is (0, 1, -1) /
+  // sqrt 2.
+  const float h = static_cast<float>(4.0 / std::sqrt(2.0));
+  const Vector3fVector positions{
+      {1.f, 1.f, 5.f}, {4.f, 1.f, 5.f}, {1.f, 1.f + h, 5.f + h}};
+  const std::vector<Triangle> triangles{{0, 1, 2}, {1, 0, 2}};
+  Vector3fVector normals;
+  std::vector<double> areas;
+  computeTriangleNormals(positions, triangles, Eigen::Vector3f::Zero(), normals, areas);
+  const float s = static_cast<float>(1.0 / std::sqrt(2.0));
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    SCOPED_TRACE(t);
+    EXPECT_NEAR(areas[t], 6.0, 1e-5);
+    expectVectorNear(normals[t], Eigen::Vector3f(0.f, s, -s));
+  }
+}
+
+TEST(MeshNormals, OrientedTowardViewpoint)
+{
+  // The same triangle seen from either side: the normal follows the viewpoint.
+  const Vector3fVector positions{{0.f, 0.f, 5.f}, {3.f, 0.f, 5.f}, {0.f, 4.f, 5.f}};
+  const std::vector<Triangle> triangles{{0, 1, 2}, {0, 2, 1}};
+  Vector3fVector normals;
+  std::vector<double> areas;
+  computeTriangleNormals(
+      positions, triangles, Eigen::Vector3f(1.f, 1.f, 10.f), normals, areas);
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    SCOPED_TRACE(t);
+    expectVectorNear(normals[t], Eigen::Vector3f(0.f, 0.f, 1.f));
+    EXPECT_NEAR(areas[t], 6.0, 1e-12);
+  }
+  // Seen from the side at x = -10, the plane x = 0 faces -x.
+  const Vector3fVector wall{{0.f, 0.f, 1.f}, {0.f, 2.f, 1.f}, {0.f, 0.f, 3.f}};
+  computeTriangleNormals(
+      wall, triangles, Eigen::Vector3f(-10.f, 0.f, 0.f), normals, areas);
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    SCOPED_TRACE(t);
+    expectVectorNear(normals[t], Eigen::Vector3f(-1.f, 0.f, 0.f));
+    EXPECT_NEAR(areas[t], 2.0, 1e-12);
+  }
+}
+
+TEST(MeshNormals, DegenerateTriangles)
+{
+  const Vector3fVector positions{
+      {0.f, 0.f, 1.f}, {1.f, 1.f, 1.f}, {2.f, 2.f, 1.f}, {0.f, 1.f, 1.f}};
+  // Collinear vertices; a repeated vertex; a proper triangle as control.
+  const std::vector<Triangle> triangles{{0, 1, 2}, {0, 0, 3}, {0, 1, 3}};
+  Vector3fVector normals;
+  std::vector<double> areas;
+  computeTriangleNormals(positions, triangles, Eigen::Vector3f::Zero(), normals, areas);
+  for (std::size_t t = 0; t < 2; ++t) {
+    SCOPED_TRACE(t);
+    EXPECT_TRUE(std::isnan(normals[t].x()));
+    EXPECT_TRUE(std::isnan(normals[t].y()));
+    EXPECT_TRUE(std::isnan(normals[t].z()));
+    EXPECT_EQ(areas[t], 0.0);
+  }
+  EXPECT_NEAR(areas[2], 0.5, 1e-12);
+  expectVectorNear(normals[2], Eigen::Vector3f(0.f, 0.f, -1.f));
+}
+
+TEST(MeshNormals, HugeCoordinatesGiveFiniteArea)
+{
+  // Legs of 1e30: the area 5e59 overflows a float (max 3.4e38) but not a double.
+  const float big = 1e30f;
+  const Vector3fVector positions{{0.f, 0.f, big}, {big, 0.f, big}, {0.f, big, big}};
+  const std::vector<Triangle> triangles{{0, 1, 2}};
+  Vector3fVector normals;
+  std::vector<double> areas;
+  computeTriangleNormals(positions, triangles, Eigen::Vector3f::Zero(), normals, areas);
+  const double leg = static_cast<double>(big);
+  ASSERT_TRUE(std::isfinite(areas[0]));
+  EXPECT_NEAR(areas[0] / (0.5 * leg * leg), 1.0, 1e-12);
+  ASSERT_TRUE(normals[0].allFinite());
+  expectVectorNear(normals[0], Eigen::Vector3f(0.f, 0.f, -1.f));
+}
+
+TEST(MeshNormals, VertexNormalIsInverseAreaWeightedMean)
+{
+  // Vertex 0 is shared by t0 (normal -z, area 1) and t1 (normal (0.6, 0, -0.8), area
+  // 4). Eq. 2: N' = (0, 0, -1) / 1 + (0.6, 0, -0.8) / 4 = (0.15, 0, -1.2), |N'| =
+  // sqrt(0.0225 + 1.44) = sqrt(1.4625). Eq. 3: A_0 = 1 + 4 = 5.
+  const std::vector<Triangle> triangles{{0, 1, 2}, {0, 3, 4}};
+  const Vector3fVector normals{{0.f, 0.f, -1.f}, {0.6f, 0.f, -0.8f}};
+  const std::vector<double> areas{1.0, 4.0};
+  Vector3fVector vertex_normals;
+  std::vector<double> vertex_areas;
+  computeVertexNormals(5, triangles, normals, areas, vertex_normals, vertex_areas);
+  ASSERT_EQ(vertex_normals.size(), 5u);
+  ASSERT_EQ(vertex_areas.size(), 5u);
+
+  const double norm = std::sqrt(1.4625);
+  expectVectorNear(vertex_normals[0],
+                   Eigen::Vector3f(static_cast<float>(0.15 / norm),
+                                   0.f,
+                                   static_cast<float>(-1.2 / norm)));
+  EXPECT_NEAR(vertex_areas[0], 5.0, 1e-12);
+  // The 1/A weighting pulls the normal toward the small triangle's: about 7.1 degrees
+  // from -z, whereas an unweighted mean would sit at 18.4 degrees.
+  EXPECT_NEAR(std::acos(-vertex_normals[0].z()), std::atan2(0.15, 1.2), 1e-6);
+
+  for (const int v : {1, 2}) {
+    expectVectorNear(vertex_normals[v], Eigen::Vector3f(0.f, 0.f, -1.f));
+    EXPECT_NEAR(vertex_areas[v], 1.0, 1e-12);
+  }
+  for (const int v : {3, 4}) {
+    expectVectorNear(vertex_normals[v], Eigen::Vector3f(0.6f, 0.f, -0.8f));
+    EXPECT_NEAR(vertex_areas[v], 4.0, 1e-12);
+  }
+}
+
+TEST(MeshNormals, VertexNormalsFromGeometry)
+{
+  // Vertex 0 at (0, 0, 2), seen from the origin, lies on t0 in the plane z = 2 (legs 1
+  // and 1: area 0.5, normal -z) and on t1 in the plane z = 2 + y (legs sqrt 2 along
+  // (0, -1, -1) and 2 along x: area sqrt 2, normal (0, 1, -1) / sqrt 2 facing the
+  // origin).
+  const Vector3fVector positions{{0.f, 0.f, 2.f},
+                                 {1.f, 0.f, 2.f},
+                                 {0.f, 1.f, 2.f},
+                                 {0.f, -1.f, 1.f},
+                                 {2.f, 0.f, 2.f}};
+  const std::vector<Triangle> triangles{{0, 1, 2}, {0, 3, 4}};
+  Vector3fVector normals;
+  std::vector<double> areas;
+  computeTriangleNormals(positions, triangles, Eigen::Vector3f::Zero(), normals, areas);
+  EXPECT_NEAR(areas[0], 0.5, 1e-12);
+  EXPECT_NEAR(areas[1], std::sqrt(2.0), 1e-6);
+  const double s = 1.0 / std::sqrt(2.0);
+  expectVectorNear(normals[1], Eigen::Vector3f(0.f, s, -s));
+
+  Vector3fVector vertex_normals;
+  std::vector<double> vertex_areas;
+  computeVertexNormals(5, triangles, normals, areas, vertex_normals, vertex_areas);
+  // N' = (0, 0, -1) / 0.5 + (0, s, -s) / sqrt 2 = (0, 0.5, -2.5).
+  const Eigen::Vector3d expected = Eigen::Vector3d(0.0, 0.5, -2.5).normalized();
+  expectVectorNear(vertex_normals[0], expected.cast<float>());
+  EXPECT_NEAR(vertex_areas[0], 0.5 + std::sqrt(2.0), 1e-6);
+}
+
+TEST(MeshNormals, DegenerateTrianglesSkipped)
+{
+  // t1 is degenerate (area 0, NaN normal), t2 has a non-finite area: neither may
+  // contribute to vertex 0's normal, and both must leave its area finite.
+  const std::vector<Triangle> triangles{{0, 1, 2}, {0, 1, 3}, {0, 2, 3}};
+  const Vector3fVector normals{
+      {0.f, 0.f, -1.f}, Eigen::Vector3f::Constant(kNaN), {1.f, 0.f, 0.f}};
+  const std::vector<double> areas{2.0, 0.0, std::numeric_limits<double>::infinity()};
+  Vector3fVector vertex_normals;
+  std::vector<double> vertex_areas;
+  computeVertexNormals(4, triangles, normals, areas, vertex_normals, vertex_areas);
+  expectVectorNear(vertex_normals[0], Eigen::Vector3f(0.f, 0.f, -1.f));
+  EXPECT_NEAR(vertex_areas[0], 2.0, 1e-12);
+  // Vertex 3 lies only on the skipped triangles.
+  EXPECT_FALSE(vertex_normals[3].allFinite());
+  EXPECT_TRUE(std::isfinite(vertex_areas[3]));
+  EXPECT_EQ(vertex_areas[3], 0.0);
+}
+
+TEST(MeshNormals, IsolatedVertexAndCancellingNormals)
+{
+  // Vertex 3 is in no triangle. Vertex 0 sees two opposite normals with equal areas:
+  // the weighted sum is zero and there is no normal.
+  const std::vector<Triangle> triangles{{0, 1, 2}, {0, 2, 1}};
+  const Vector3fVector normals{{0.f, 0.f, -1.f}, {0.f, 0.f, 1.f}};
+  const std::vector<double> areas{1.0, 1.0};
+  Vector3fVector vertex_normals;
+  std::vector<double> vertex_areas;
+  computeVertexNormals(4, triangles, normals, areas, vertex_normals, vertex_areas);
+  EXPECT_TRUE(std::isnan(vertex_normals[3].x()));
+  EXPECT_TRUE(std::isnan(vertex_normals[3].y()));
+  EXPECT_TRUE(std::isnan(vertex_normals[3].z()));
+  EXPECT_EQ(vertex_areas[3], 0.0);
+  EXPECT_FALSE(vertex_normals[0].allFinite());
+  EXPECT_NEAR(vertex_areas[0], 2.0, 1e-12);
+}
+
+TEST(MeshNormals, EdgeOnHeadOnAndGrazing)
+{
+  // t0 faces the origin head-on (its centroid on the z axis); t1 lies in the plane
+  // y = 0, which contains the line of sight to its centroid (0, 0, 16/3).
+  const Vector3fVector positions{{-1.f, -1.f, 5.f},
+                                 {2.f, -1.f, 5.f},
+                                 {-1.f, 2.f, 5.f},
+                                 {0.f, 0.f, 4.f},
+                                 {1.f, 0.f, 6.f},
+                                 {-1.f, 0.f, 6.f}};
+  const std::vector<Triangle> triangles{{0, 1, 2}, {3, 4, 5}};
+  Vector3fVector normals;
+  std::vector<double> areas;
+  computeTriangleNormals(positions, triangles, Eigen::Vector3f::Zero(), normals, areas);
+  std::vector<std::uint8_t> edge_on;
+  for (const double max_incidence : {1.0 * kDeg, 45.0 * kDeg, 89.0 * kDeg}) {
+    SCOPED_TRACE(max_incidence);
+    markEdgeOnTriangles(
+        positions, triangles, normals, Eigen::Vector3f::Zero(), max_incidence, edge_on);
+    ASSERT_EQ(edge_on.size(), 2u);
+    EXPECT_EQ(edge_on[0], 0);
+    EXPECT_EQ(edge_on[1], 1);
+  }
+  // From far along +x the head-on triangle is seen at grazing incidence.
+  markEdgeOnTriangles(positions,
+                      triangles,
+                      normals,
+                      Eigen::Vector3f(1000.f, 0.f, 5.f),
+                      80.0 * kDeg,
+                      edge_on);
+  EXPECT_EQ(edge_on[0], 1);
+}
+
+TEST(MeshNormals, EdgeOnThreshold)
+{
+  // A triangle centred on the optical axis at z = 5 whose normal makes 60 degrees with
+  // the line of sight (0, 0, 1).
+  const double incidence = 60.0 * kDeg;
+  const Eigen::Vector3d normal(std::sin(incidence), 0.0, -std::cos(incidence));
+  const Vector3fVector positions =
+      equilateralAround(Eigen::Vector3d(0.0, 0.0, 5.0), normal, 1.0);
+  const std::vector<Triangle> triangles{{0, 1, 2}};
+  Vector3fVector normals;
+  std::vector<double> areas;
+  computeTriangleNormals(positions, triangles, Eigen::Vector3f::Zero(), normals, areas);
+  expectVectorNear(normals[0], normal.cast<float>(), 1e-5f);
+
+  std::vector<std::uint8_t> edge_on;
+  markEdgeOnTriangles(positions,
+                      triangles,
+                      normals,
+                      Eigen::Vector3f::Zero(),
+                      incidence + 0.5 * kDeg,
+                      edge_on);
+  EXPECT_EQ(edge_on[0], 0);
+  markEdgeOnTriangles(positions,
+                      triangles,
+                      normals,
+                      Eigen::Vector3f::Zero(),
+                      incidence - 0.5 * kDeg,
+                      edge_on);
+  EXPECT_EQ(edge_on[0], 1);
+  // The test uses |cos|: a normal facing away from the viewer is judged the same way.
+  const Vector3fVector reversed{-normals[0]};
+  markEdgeOnTriangles(positions,
+                      triangles,
+                      reversed,
+                      Eigen::Vector3f::Zero(),
+                      incidence + 0.5 * kDeg,
+                      edge_on);
+  EXPECT_EQ(edge_on[0], 0);
+}
+
+TEST(MeshNormals, EdgeOnRightAngleFlagsOnlyDegenerate)
+{
+  // The plane y = 0 contains the line of sight; a degenerate triangle has no normal.
+  const Vector3fVector positions{{0.f, 0.f, 4.f},
+                                 {1.f, 0.f, 6.f},
+                                 {-1.f, 0.f, 6.f},
+                                 {0.f, 0.f, 1.f},
+                                 {1.f, 1.f, 1.f},
+                                 {2.f, 2.f, 1.f}};
+  const std::vector<Triangle> triangles{{0, 1, 2}, {3, 4, 5}};
+  Vector3fVector normals;
+  std::vector<double> areas;
+  computeTriangleNormals(positions, triangles, Eigen::Vector3f::Zero(), normals, areas);
+  ASSERT_TRUE(normals[0].allFinite());
+  ASSERT_FALSE(normals[1].allFinite());
+  std::vector<std::uint8_t> edge_on;
+  for (const double max_incidence : {M_PI / 2.0, M_PI}) {
+    SCOPED_TRACE(max_incidence);
+    markEdgeOnTriangles(
+        positions, triangles, normals, Eigen::Vector3f::Zero(), max_incidence, edge_on);
+    EXPECT_EQ(edge_on[0], 0);
+    EXPECT_EQ(edge_on[1], 1);
+  }
+}
+
+TEST(MeshNormals, MedianEdgeLength)
+{
+  // t0 has edges 1, 2 and sqrt 5; alone its median is 2.
+  const Vector3fVector positions{
+      {0.f, 0.f, 0.f}, {1.f, 0.f, 0.f}, {0.f, 2.f, 0.f}, {0.f, 0.f, 7.f}};
+  EXPECT_NEAR(medianEdgeLength(positions, {{0, 1, 2}}), 2.0, 1e-12);
+  // With t1 (edges 1, sqrt 50, 7): 1, 1, 2, sqrt 5, 7, sqrt 50. The two middle values
+  // are 2 and sqrt 5; accept either (an even count has no single median).
+  const double both = medianEdgeLength(positions, {{0, 1, 2}, {0, 1, 3}});
+  EXPECT_TRUE(std::abs(both - 2.0) < 1e-12 || std::abs(both - std::sqrt(5.0)) < 1e-6)
+      << both;
+  // t2 adds 2, sqrt 53, 7: 1, 1, 2, 2, sqrt 5, 7, 7, sqrt 50, sqrt 53 -> sqrt 5.
+  EXPECT_NEAR(medianEdgeLength(positions, {{0, 1, 2}, {0, 1, 3}, {0, 2, 3}}),
+              std::sqrt(5.0),
+              1e-6);
+  EXPECT_EQ(medianEdgeLength(positions, {}), 0.0);
+}
+
+int
+main(int argc, char** argv)
+{
+  testing::InitGoogleTest(&argc, argv);
+  return RUN_ALL_TESTS();
+}

@@ -1,0 +1,585 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
+ *
+ *  Unit tests of the multi-resolution octree (paper, Sec. III.C, eq. 3-6).
+ */
+
+#include <pcl_selective_seg/octree_pointcloud_normal_variance.h>
+
+#include <gtest/gtest.h>
+#include <pcl/pcl_base.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <numeric>
+#include <random>
+#include <set>
+#include <vector>
+
+using pcl::selective_seg::AdaptiveLeaf;
+using Octree = pcl::selective_seg::OctreePointCloudNormalVariance<pcl::PointXYZ>;
+
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+constexpr double kPaperThreshold = 7.6 * kDeg;
+constexpr std::size_t kMinPoints = 8;
+
+/** A cloud with per-point normals (toward the sensor) and areas A_p. */
+struct Scene {
+  pcl::PointCloud<pcl::PointXYZ>::Ptr cloud{new pcl::PointCloud<pcl::PointXYZ>};
+  pcl::PointCloud<pcl::Normal>::Ptr normals{new pcl::PointCloud<pcl::Normal>};
+  std::shared_ptr<std::vector<double>> areas{new std::vector<double>};
+
+  void add(const Eigen::Vector3f& p, const Eigen::Vector3f& n, double area)
+  {
+    cloud->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
+    normals->push_back(pcl::Normal(n.x(), n.y(), n.z()));
+    areas->push_back(area);
+  }
+};
+
+/** Build the tree over \a scene (optionally over \a indices) and split it. */
+std::unique_ptr<Octree>
+buildOctree(const Scene& scene,
+            double resolution,
+            double max_std_dev,
+            std::size_t min_points = kMinPoints,
+            const pcl::IndicesPtr& indices = nullptr,
+            const Eigen::Quaternionf* orientation = nullptr)
+{
+  auto octree = std::make_unique<Octree>(resolution);
+  octree->setInputCloud(scene.cloud, indices);
+  octree->setInputNormals(scene.normals, scene.areas);
+  if (orientation)
+    octree->setSensorOrientation(*orientation);
+  EXPECT_TRUE(octree->addPointsFromInputCloud());
+  octree->computeAdaptiveLeaves(max_std_dev, min_points);
+  return octree;
+}
+
+/** A unit normal facing a sensor on the -z side, tilted by theta about y and phi about
+ * x: the reversed normal (what eq. 5 measures) is (tan theta, tan phi, 1), normalized.
+ */
+Eigen::Vector3f
+facingNormal(double theta, double phi)
+{
+  return -Eigen::Vector3d(std::tan(theta), std::tan(phi), 1.0)
+              .normalized()
+              .cast<float>();
+}
+
+/** A ridge of two planes at 90 degrees seen from the origin: z = 2 + x for x in
+ * [-1, 0] and z = 2 - x for x in (0, 0.65], y in [0, 1], on a grid of step 0.05. The
+ * asymmetry keeps the fold off the octree's first split planes. */
+Scene
+ridge()
+{
+  Scene scene;
+  const float s = static_cast<float>(1.0 / std::sqrt(2.0));
+  for (int i = -20; i <= 13; ++i)
+    for (int j = 0; j <= 20; ++j) {
+      const float x = 0.05f * static_cast<float>(i);
+      const float y = 0.05f * static_cast<float>(j);
+      const Eigen::Vector3f n =
+          i <= 0 ? Eigen::Vector3f(s, 0.f, -s) : Eigen::Vector3f(-s, 0.f, -s);
+      scene.add(Eigen::Vector3f(x, y, 2.f - std::abs(x)), n, 0.005);
+    }
+  return scene;
+}
+
+/** The independent reference of eq. 4-5 over a set of points: theta and phi of each
+ * reversed normal in the sensor frame, deviations from the angles of the 1/A_p weighted
+ * mean normal wrapped into (-pi, pi]. */
+struct Reference {
+  Eigen::Vector3d normal; ///< input orientation
+  double sigma_theta;
+  double sigma_phi;
+  double area;
+};
+
+double
+wrap(double a)
+{
+  return std::remainder(a, 2.0 * M_PI);
+}
+
+Reference
+reference(const Scene& scene,
+          const std::vector<pcl::index_t>& points,
+          const Eigen::Matrix3d& orientation = Eigen::Matrix3d::Identity())
+{
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  double sum_w = 0.0, area = 0.0;
+  std::vector<Eigen::Vector3d> m;
+  for (const auto i : points) {
+    const Eigen::Vector3d n = (*scene.normals)[i].getNormalVector3fMap().cast<double>();
+    m.push_back(-(orientation.transpose() * n).normalized());
+    sum += m.back() / (*scene.areas)[i];
+    sum_w += 1.0 / (*scene.areas)[i];
+    area += (*scene.areas)[i];
+  }
+  const Eigen::Vector3d mean = sum.normalized();
+  double var_theta = 0.0, var_phi = 0.0;
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    const double w = 1.0 / (*scene.areas)[points[k]];
+    const double dt =
+        wrap(std::atan2(m[k].x(), m[k].z()) - std::atan2(mean.x(), mean.z()));
+    const double dp =
+        wrap(std::atan2(m[k].y(), m[k].z()) - std::atan2(mean.y(), mean.z()));
+    var_theta += w * dt * dt;
+    var_phi += w * dp * dp;
+  }
+  return {-(orientation * mean),
+          std::sqrt(var_theta / sum_w),
+          std::sqrt(var_phi / sum_w),
+          area};
+}
+
+std::vector<pcl::index_t>
+leafPoints(const Octree& octree, const AdaptiveLeaf& leaf)
+{
+  const auto& ordered = octree.getOrderedIndices();
+  return {ordered.begin() + leaf.begin, ordered.begin() + leaf.end};
+}
+
+/** Finest-level key of a point, as PCL's octree computes it from its bounding box. */
+pcl::octree::OctreeKey
+finestKey(const Octree& octree, const pcl::PointXYZ& p)
+{
+  double min_x, min_y, min_z, max_x, max_y, max_z;
+  octree.getBoundingBox(min_x, min_y, min_z, max_x, max_y, max_z);
+  const double r = octree.getResolution();
+  return pcl::octree::OctreeKey(static_cast<pcl::uindex_t>((p.x - min_x) / r),
+                                static_cast<pcl::uindex_t>((p.y - min_y) / r),
+                                static_cast<pcl::uindex_t>((p.z - min_z) / r));
+}
+
+bool
+inNode(const pcl::octree::OctreeKey& finest,
+       unsigned shift,
+       const pcl::octree::OctreeKey& key)
+{
+  return (finest.x >> shift) == key.x && (finest.y >> shift) == key.y &&
+         (finest.z >> shift) == key.z;
+}
+
+std::vector<pcl::index_t>
+validPoints(const Scene& scene)
+{
+  std::vector<pcl::index_t> valid;
+  for (std::size_t i = 0; i < scene.cloud->size(); ++i)
+    if (pcl::isFinite((*scene.cloud)[i]) && pcl::isNormalFinite((*scene.normals)[i]) &&
+        std::isfinite((*scene.areas)[i]) && (*scene.areas)[i] > 0.0)
+      valid.push_back(static_cast<pcl::index_t>(i));
+  return valid;
+}
+
+/** The leaves' ranges tile [0, #ordered) in order, and the ordered indices are a
+ * permutation of \a expected. */
+void
+expectPartition(const Octree& octree, std::vector<pcl::index_t> expected)
+{
+  const auto& leaves = octree.getAdaptiveLeaves();
+  ASSERT_FALSE(leaves.empty());
+  std::size_t next = 0;
+  for (const auto& leaf : leaves) {
+    EXPECT_EQ(leaf.begin, next);
+    EXPECT_LT(leaf.begin, leaf.end);
+    next = leaf.end;
+  }
+  EXPECT_EQ(next, octree.getOrderedIndices().size());
+  pcl::Indices ordered = octree.getOrderedIndices();
+  std::sort(ordered.begin(), ordered.end());
+  std::sort(expected.begin(), expected.end());
+  EXPECT_EQ(ordered, expected);
+}
+
+} // namespace
+
+TEST(OctreePointCloudNormalVariance, PlaneFacingSensorIsOneLeaf)
+{
+  Scene scene;
+  for (int i = 0; i < 5; ++i)
+    for (int j = 0; j < 5; ++j)
+      scene.add(
+          Eigen::Vector3f(0.1f * i, 0.1f * j, 2.f), Eigen::Vector3f(0, 0, -1), 0.01);
+  const auto octree = buildOctree(scene, 0.02, kPaperThreshold);
+  ASSERT_GE(octree->getTreeDepth(), 4u); // 0.4 m / 0.02 m = 20 voxels: room to split
+  const auto& leaves = octree->getAdaptiveLeaves();
+  ASSERT_EQ(leaves.size(), 1u);
+  const AdaptiveLeaf& leaf = leaves[0];
+  EXPECT_EQ(leaf.depth, 0u);
+  EXPECT_EQ(leaf.key.x, 0u);
+  EXPECT_EQ(leaf.key.y, 0u);
+  EXPECT_EQ(leaf.key.z, 0u);
+  EXPECT_EQ(leaf.begin, 0u);
+  EXPECT_EQ(leaf.end, 25u);
+  EXPECT_FLOAT_EQ(leaf.sigma_theta, 0.f);
+  EXPECT_FLOAT_EQ(leaf.sigma_phi, 0.f);
+  EXPECT_NEAR(leaf.normal.x(), 0.f, 1e-6f);
+  EXPECT_NEAR(leaf.normal.y(), 0.f, 1e-6f);
+  EXPECT_NEAR(leaf.normal.z(), -1.f, 1e-6f);
+  EXPECT_NEAR(leaf.area, 0.25, 1e-12); // eq. 6: 25 x 0.01
+}
+
+TEST(OctreePointCloudNormalVariance, VoxelNormalIsInverseAreaWeightedMean)
+{
+  // eq. 4: N' = (0, 0, -1) / 1 + (0.6, 0, -0.8) / 2 + (0, 0.6, -0.8) / 4
+  //           = (0.3, 0.15, -1.6); eq. 6: A_v = 1 + 2 + 4 = 7.
+  Scene scene;
+  scene.add(Eigen::Vector3f(0.f, 0.f, 1.f), Eigen::Vector3f(0.f, 0.f, -1.f), 1.0);
+  scene.add(Eigen::Vector3f(0.1f, 0.f, 1.f), Eigen::Vector3f(0.6f, 0.f, -0.8f), 2.0);
+  scene.add(Eigen::Vector3f(0.f, 0.1f, 1.f), Eigen::Vector3f(0.f, 0.6f, -0.8f), 4.0);
+  const auto octree = buildOctree(scene, 0.01, M_PI);
+  ASSERT_EQ(octree->getAdaptiveLeaves().size(), 1u);
+  const AdaptiveLeaf& leaf = octree->getAdaptiveLeaves()[0];
+  const double norm = std::sqrt(0.09 + 0.0225 + 2.56);
+  EXPECT_NEAR(leaf.normal.x(), 0.3 / norm, 1e-6);
+  EXPECT_NEAR(leaf.normal.y(), 0.15 / norm, 1e-6);
+  EXPECT_NEAR(leaf.normal.z(), -1.6 / norm, 1e-6);
+  EXPECT_NEAR(leaf.area, 7.0, 1e-12);
+}
+
+TEST(OctreePointCloudNormalVariance, SigmaThetaAroundWeightedMeanNormal)
+{
+  // Four normals at theta = 0, 0, 0 and 80 degrees (phi = 0), equal areas. The mean
+  // normal's angle is atan2(sin 80, 3 + cos 80) = 17.24 degrees (not the mean angle,
+  // 20), and sigma_theta the population standard deviation around it (34.75 degrees,
+  // against 34.64 around 20).
+  Scene scene;
+  const std::vector<double> thetas{0.0, 0.0, 0.0, 80.0 * kDeg};
+  for (std::size_t k = 0; k < thetas.size(); ++k)
+    scene.add(Eigen::Vector3f(0.1f * k, 0.f, 1.f), facingNormal(thetas[k], 0.0), 1.0);
+  const auto octree = buildOctree(scene, 0.01, M_PI);
+  ASSERT_EQ(octree->getAdaptiveLeaves().size(), 1u);
+  const AdaptiveLeaf& leaf = octree->getAdaptiveLeaves()[0];
+
+  const double mean = std::atan2(std::sin(thetas[3]), 3.0 + std::cos(thetas[3]));
+  EXPECT_NEAR(mean / kDeg, 17.24, 0.01);
+  double sum = 0.0;
+  for (const double t : thetas)
+    sum += (t - mean) * (t - mean);
+  const double expected = std::sqrt(sum / 4.0);
+  EXPECT_NEAR(expected / kDeg, 34.75, 0.01);
+  EXPECT_NEAR(leaf.sigma_theta, expected, 1e-6);
+  EXPECT_NEAR(leaf.sigma_phi, 0.0, 1e-6);
+}
+
+TEST(OctreePointCloudNormalVariance, SigmaPhiWeightedByInverseArea)
+{
+  // phi = -30, 0, 20, 50 degrees with A_p = 1, 2, 2, 4: weights 1, 1/2, 1/2, 1/4.
+  Scene scene;
+  const std::vector<double> phis{-30.0 * kDeg, 0.0, 20.0 * kDeg, 50.0 * kDeg};
+  const std::vector<double> areas{1.0, 2.0, 2.0, 4.0};
+  for (std::size_t k = 0; k < phis.size(); ++k)
+    scene.add(
+        Eigen::Vector3f(0.f, 0.1f * k, 1.f), facingNormal(0.0, phis[k]), areas[k]);
+  const auto octree = buildOctree(scene, 0.01, M_PI);
+  ASSERT_EQ(octree->getAdaptiveLeaves().size(), 1u);
+  const AdaptiveLeaf& leaf = octree->getAdaptiveLeaves()[0];
+
+  double sy = 0.0, sz = 0.0, sw = 0.0;
+  for (std::size_t k = 0; k < phis.size(); ++k) {
+    sy += std::sin(phis[k]) / areas[k];
+    sz += std::cos(phis[k]) / areas[k];
+    sw += 1.0 / areas[k];
+  }
+  const double mean = std::atan2(sy, sz);
+  double var = 0.0;
+  for (std::size_t k = 0; k < phis.size(); ++k)
+    var += (phis[k] - mean) * (phis[k] - mean) / areas[k];
+  EXPECT_NEAR(leaf.sigma_phi, std::sqrt(var / sw), 1e-6);
+  EXPECT_NEAR(leaf.sigma_theta, 0.0, 1e-6);
+  EXPECT_NEAR(leaf.normal.y(), -std::sin(mean), 1e-6);
+  EXPECT_NEAR(leaf.normal.z(), -std::cos(mean), 1e-6);
+}
+
+TEST(OctreePointCloudNormalVariance, WallFacingSensorHasSmallSigma)
+{
+  // Normals (+-0.01, +-0.01, -1), signs alternating: atan2(n_x, n_z) would jump between
+  // +pi and -pi. The deviations are atan(0.01) ~ 0.01 rad on both axes.
+  Scene scene;
+  for (int i = 0; i < 10; ++i)
+    for (int j = 0; j < 10; ++j) {
+      const float sx = (i + j) % 2 == 0 ? 0.01f : -0.01f;
+      const float sy = i % 2 == 0 ? 0.01f : -0.01f;
+      scene.add(Eigen::Vector3f(0.05f * i, 0.05f * j, 3.f),
+                Eigen::Vector3f(sx, sy, -1.f).normalized(),
+                0.0025);
+    }
+  const auto octree = buildOctree(scene, 0.01, kPaperThreshold);
+  ASSERT_EQ(octree->getAdaptiveLeaves().size(), 1u);
+  const AdaptiveLeaf& leaf = octree->getAdaptiveLeaves()[0];
+  EXPECT_NEAR(leaf.sigma_theta, std::atan(0.01), 1e-5);
+  EXPECT_NEAR(leaf.sigma_phi, std::atan(0.01), 1e-5);
+  EXPECT_NEAR(leaf.normal.z(), -1.f, 1e-6f);
+
+  // The same wall with its normals reversed (facing away): the angles sit at the +-pi
+  // seam, and the wrapped deviations keep sigma small.
+  for (auto& n : scene.normals->points)
+    n.getNormalVector3fMap() *= -1.f;
+  const auto reversed = buildOctree(scene, 0.01, kPaperThreshold);
+  ASSERT_EQ(reversed->getAdaptiveLeaves().size(), 1u);
+  EXPECT_NEAR(reversed->getAdaptiveLeaves()[0].sigma_theta, std::atan(0.01), 1e-5);
+  EXPECT_NEAR(reversed->getAdaptiveLeaves()[0].sigma_phi, std::atan(0.01), 1e-5);
+}
+
+TEST(OctreePointCloudNormalVariance, TwoPlanesSplit)
+{
+  const Scene scene = ridge();
+  const double resolution = 0.05;
+  const auto octree = buildOctree(scene, resolution, kPaperThreshold);
+  const auto& leaves = octree->getAdaptiveLeaves();
+  const unsigned depth = octree->getTreeDepth();
+  ASSERT_GT(leaves.size(), 2u);
+  expectPartition(*octree, validPoints(scene));
+
+  std::vector<pcl::octree::OctreeKey> keys;
+  for (const auto& p : scene.cloud->points)
+    keys.push_back(finestKey(*octree, p));
+
+  std::size_t largest = 0;
+  for (const auto& leaf : leaves) {
+    SCOPED_TRACE(testing::Message()
+                 << "leaf at depth " << leaf.depth << " key " << leaf.key.x << " "
+                 << leaf.key.y << " " << leaf.key.z);
+    const auto points = leafPoints(*octree, leaf);
+    largest = std::max(largest, points.size());
+    for (const auto i : points)
+      ASSERT_TRUE(inNode(keys[i], depth - leaf.depth, leaf.key));
+    // Its own statistics, as stored.
+    const Reference ref = reference(scene, points);
+    EXPECT_NEAR(leaf.sigma_theta, ref.sigma_theta, 1e-5);
+    EXPECT_NEAR(leaf.sigma_phi, ref.sigma_phi, 1e-5);
+    EXPECT_NEAR((leaf.normal.cast<double>() - ref.normal).norm(), 0.0, 1e-5);
+    EXPECT_NEAR(leaf.area, ref.area, 1e-9);
+    // Kept: homogeneous, or too small to split, or at the finest level.
+    const bool homogeneous =
+        ref.sigma_theta <= kPaperThreshold && ref.sigma_phi <= kPaperThreshold;
+    EXPECT_TRUE(homogeneous || points.size() < kMinPoints || leaf.depth == depth);
+    // The highest such node: its parent had to be split.
+    if (leaf.depth == 0)
+      continue;
+    const unsigned shift = depth - leaf.depth + 1;
+    const pcl::octree::OctreeKey parent(
+        leaf.key.x >> 1, leaf.key.y >> 1, leaf.key.z >> 1);
+    std::vector<pcl::index_t> parent_points;
+    for (std::size_t i = 0; i < keys.size(); ++i)
+      if (inNode(keys[i], shift, parent))
+        parent_points.push_back(static_cast<pcl::index_t>(i));
+    const Reference up = reference(scene, parent_points);
+    EXPECT_TRUE(up.sigma_theta > kPaperThreshold || up.sigma_phi > kPaperThreshold);
+    EXPECT_GE(parent_points.size(), kMinPoints);
+  }
+  // Large flat parts stay whole: some leaf holds far more than one finest voxel.
+  EXPECT_GE(largest, 16u);
+}
+
+TEST(OctreePointCloudNormalVariance, MinPointsToSplit)
+{
+  // With a minimum above the point count the root is kept, however much it varies.
+  const Scene scene = ridge();
+  const auto octree =
+      buildOctree(scene, 0.05, kPaperThreshold, scene.cloud->size() + 1);
+  ASSERT_EQ(octree->getAdaptiveLeaves().size(), 1u);
+  EXPECT_EQ(octree->getAdaptiveLeaves()[0].depth, 0u);
+  EXPECT_GT(octree->getAdaptiveLeaves()[0].sigma_theta, kPaperThreshold);
+}
+
+TEST(OctreePointCloudNormalVariance, InvalidPointsSkipped)
+{
+  Scene scene = ridge();
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  (*scene.normals)[3].normal_x = nan;
+  (*scene.areas)[10] = 0.0;
+  (*scene.areas)[11] = -1.0;
+  (*scene.areas)[12] = std::numeric_limits<double>::infinity();
+  (*scene.areas)[13] = std::numeric_limits<double>::quiet_NaN();
+  (*scene.cloud)[20].x = nan;
+  const auto valid = validPoints(scene);
+  ASSERT_EQ(valid.size(), scene.cloud->size() - 6);
+  const auto octree = buildOctree(scene, 0.05, kPaperThreshold);
+  expectPartition(*octree, valid);
+
+  // With indices: only the listed valid points.
+  pcl::IndicesPtr indices(new pcl::Indices);
+  for (pcl::index_t i = 0; i < static_cast<pcl::index_t>(scene.cloud->size()); i += 3)
+    indices->push_back(i);
+  const auto subset = buildOctree(scene, 0.05, kPaperThreshold, kMinPoints, indices);
+  std::vector<pcl::index_t> expected;
+  std::set_intersection(indices->begin(),
+                        indices->end(),
+                        valid.begin(),
+                        valid.end(),
+                        std::back_inserter(expected));
+  expectPartition(*subset, expected);
+}
+
+TEST(OctreePointCloudNormalVariance, RecomputeWithAnotherThreshold)
+{
+  // computeAdaptiveLeaves() may run again on the same tree: the result is that of a
+  // fresh tree with the new parameters.
+  const Scene scene = ridge();
+  const auto tree = buildOctree(scene, 0.05, M_PI);
+  ASSERT_EQ(tree->getAdaptiveLeaves().size(), 1u);
+  tree->computeAdaptiveLeaves(kPaperThreshold, kMinPoints);
+  const auto fresh = buildOctree(scene, 0.05, kPaperThreshold);
+  ASSERT_EQ(tree->getAdaptiveLeaves().size(), fresh->getAdaptiveLeaves().size());
+  ASSERT_GT(tree->getAdaptiveLeaves().size(), 1u);
+  EXPECT_EQ(tree->getOrderedIndices(), fresh->getOrderedIndices());
+  for (std::size_t l = 0; l < fresh->getAdaptiveLeaves().size(); ++l) {
+    const AdaptiveLeaf& a = tree->getAdaptiveLeaves()[l];
+    const AdaptiveLeaf& b = fresh->getAdaptiveLeaves()[l];
+    EXPECT_EQ(a.key, b.key);
+    EXPECT_EQ(a.depth, b.depth);
+    EXPECT_EQ(a.begin, b.begin);
+    EXPECT_EQ(a.end, b.end);
+    EXPECT_EQ(a.sigma_theta, b.sigma_theta);
+  }
+}
+
+TEST(OctreePointCloudNormalVariance, NoValidPoint)
+{
+  Scene scene;
+  scene.add(Eigen::Vector3f(0.f, 0.f, 1.f), Eigen::Vector3f(0.f, 0.f, -1.f), 0.0);
+  Octree octree(0.1);
+  octree.setInputCloud(scene.cloud);
+  octree.setInputNormals(scene.normals, scene.areas);
+  EXPECT_FALSE(octree.addPointsFromInputCloud());
+  octree.computeAdaptiveLeaves(kPaperThreshold, kMinPoints);
+  EXPECT_TRUE(octree.getAdaptiveLeaves().empty());
+  EXPECT_TRUE(octree.getOrderedIndices().empty());
+}
+
+TEST(OctreePointCloudNormalVariance, InsertionOrderIndependence)
+{
+  const Scene scene = ridge();
+  const auto reference_tree = buildOctree(scene, 0.05, kPaperThreshold);
+  const auto& expected = reference_tree->getAdaptiveLeaves();
+
+  pcl::IndicesPtr shuffled(new pcl::Indices(scene.cloud->size()));
+  std::iota(shuffled->begin(), shuffled->end(), 0);
+  std::mt19937 rng(42);
+  std::shuffle(shuffled->begin(), shuffled->end(), rng);
+  const auto shuffled_tree =
+      buildOctree(scene, 0.05, kPaperThreshold, kMinPoints, shuffled);
+
+  // The same cloud with its points permuted: point k of the copy is point perm[k].
+  std::vector<pcl::index_t> perm(scene.cloud->size());
+  std::iota(perm.begin(), perm.end(), 0);
+  std::shuffle(perm.begin(), perm.end(), rng);
+  Scene permuted;
+  for (const auto i : perm)
+    permuted.add((*scene.cloud)[i].getVector3fMap(),
+                 (*scene.normals)[i].getNormalVector3fMap(),
+                 (*scene.areas)[i]);
+  const auto permuted_tree = buildOctree(permuted, 0.05, kPaperThreshold);
+
+  for (const Octree* other : {shuffled_tree.get(), permuted_tree.get()}) {
+    const bool is_permuted = other == permuted_tree.get();
+    SCOPED_TRACE(is_permuted ? "permuted cloud" : "shuffled indices");
+    const auto& leaves = other->getAdaptiveLeaves();
+    ASSERT_EQ(leaves.size(), expected.size());
+    for (std::size_t l = 0; l < leaves.size(); ++l) {
+      SCOPED_TRACE(l);
+      EXPECT_EQ(leaves[l].key, expected[l].key);
+      EXPECT_EQ(leaves[l].depth, expected[l].depth);
+      EXPECT_EQ(leaves[l].begin, expected[l].begin);
+      EXPECT_EQ(leaves[l].end, expected[l].end);
+      EXPECT_NEAR((leaves[l].normal - expected[l].normal).norm(), 0.f, 1e-6f);
+      EXPECT_NEAR(leaves[l].sigma_theta, expected[l].sigma_theta, 1e-6f);
+      EXPECT_NEAR(leaves[l].sigma_phi, expected[l].sigma_phi, 1e-6f);
+      EXPECT_NEAR(leaves[l].area, expected[l].area, 1e-9);
+      std::set<pcl::index_t> mine;
+      for (const auto i : leafPoints(*other, leaves[l]))
+        mine.insert(is_permuted ? perm[i] : i);
+      const auto theirs = leafPoints(*reference_tree, expected[l]);
+      EXPECT_EQ(mine, std::set<pcl::index_t>(theirs.begin(), theirs.end()));
+    }
+  }
+}
+
+TEST(OctreePointCloudNormalVariance, VoxelGeometry)
+{
+  const Scene scene = ridge();
+  const double resolution = 0.05;
+  const auto octree = buildOctree(scene, resolution, kPaperThreshold);
+  const unsigned depth = octree->getTreeDepth();
+  EXPECT_DOUBLE_EQ(octree->getVoxelSideLength(depth), resolution);
+  for (unsigned d = 0; d < depth; ++d)
+    EXPECT_DOUBLE_EQ(octree->getVoxelSideLength(d),
+                     2.0 * octree->getVoxelSideLength(d + 1));
+  // The root covers the bounding box.
+  double min_x, min_y, min_z, max_x, max_y, max_z;
+  octree->getBoundingBox(min_x, min_y, min_z, max_x, max_y, max_z);
+  EXPECT_NEAR(octree->getVoxelSideLength(0), max_x - min_x, 1e-9);
+
+  std::set<unsigned> depths;
+  for (const auto& leaf : octree->getAdaptiveLeaves()) {
+    depths.insert(leaf.depth);
+    const Eigen::Vector3f centre = octree->getVoxelCentre(leaf);
+    const float half =
+        0.5f * static_cast<float>(octree->getVoxelSideLength(leaf.depth));
+    for (const auto i : leafPoints(*octree, leaf)) {
+      const Eigen::Vector3f offset = (*scene.cloud)[i].getVector3fMap() - centre;
+      EXPECT_LE(offset.cwiseAbs().maxCoeff(), half * (1.f + 1e-5f))
+          << "point " << i << " outside its leaf at depth " << leaf.depth;
+    }
+  }
+  EXPECT_GT(depths.size(), 1u); // several resolutions
+}
+
+TEST(OctreePointCloudNormalVariance, SensorOrientation)
+{
+  // A noisy wall facing a sensor at the origin that looks along +z.
+  Scene wall;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> noise(-0.05f, 0.05f);
+  for (int i = 0; i < 10; ++i)
+    for (int j = 0; j < 10; ++j)
+      wall.add(Eigen::Vector3f(0.05f * i, 0.05f * j, 3.f),
+               Eigen::Vector3f(noise(rng), noise(rng), -1.f).normalized(),
+               0.0025);
+  const auto upright = buildOctree(wall, 0.01, M_PI);
+  ASSERT_EQ(upright->getAdaptiveLeaves().size(), 1u);
+  const AdaptiveLeaf expected = upright->getAdaptiveLeaves()[0];
+  ASSERT_GT(expected.sigma_theta, 0.01f);
+
+  // Rotate the cloud, its normals and the sensor together: the wall now faces a sensor
+  // that looks roughly along +x.
+  const Eigen::Quaternionf q(
+      Eigen::AngleAxisf(80.f * static_cast<float>(kDeg), Eigen::Vector3f::UnitY()) *
+      Eigen::AngleAxisf(10.f * static_cast<float>(kDeg), Eigen::Vector3f::UnitX()));
+  Scene rotated;
+  for (std::size_t i = 0; i < wall.cloud->size(); ++i)
+    rotated.add(q * (*wall.cloud)[i].getVector3fMap(),
+                q * (*wall.normals)[i].getNormalVector3fMap(),
+                (*wall.areas)[i]);
+  const auto turned = buildOctree(rotated, 0.01, M_PI, kMinPoints, nullptr, &q);
+  ASSERT_EQ(turned->getAdaptiveLeaves().size(), 1u);
+  const AdaptiveLeaf& leaf = turned->getAdaptiveLeaves()[0];
+  EXPECT_NEAR(leaf.sigma_theta, expected.sigma_theta, 1e-5f);
+  EXPECT_NEAR(leaf.sigma_phi, expected.sigma_phi, 1e-5f);
+  // The leaf normal is reported in the cloud frame.
+  EXPECT_NEAR((leaf.normal - q * expected.normal).norm(), 0.f, 1e-5f);
+  const Reference ref = reference(
+      rotated, leafPoints(*turned, leaf), q.toRotationMatrix().cast<double>());
+  EXPECT_NEAR(leaf.sigma_theta, ref.sigma_theta, 1e-5);
+
+  // Without the orientation the angles are measured in the wrong frame.
+  const auto unaware = buildOctree(rotated, 0.01, M_PI);
+  EXPECT_GT(std::abs(unaware->getAdaptiveLeaves()[0].sigma_phi - expected.sigma_phi),
+            0.01f);
+}
+
+int
+main(int argc, char** argv)
+{
+  testing::InitGoogleTest(&argc, argv);
+  return RUN_ALL_TESTS();
+}

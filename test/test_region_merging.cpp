@@ -1,0 +1,434 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
+ *
+ *  Unit tests of the seed merging and triangle classes (paper, Sec. III.D, eq. 6-10).
+ */
+
+#include <pcl_selective_seg/region_merging.h>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+using pcl::selective_seg::classifyTriangles;
+using pcl::selective_seg::Incidence;
+using pcl::selective_seg::MergeInput;
+using pcl::selective_seg::mergeSeedSegments;
+using pcl::selective_seg::Triangle;
+using pcl::selective_seg::TriangleClass;
+using pcl::selective_seg::Vector3fVector;
+using pcl::selective_seg::vertexTriangles;
+
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+constexpr double kThreshold = 25.0 * kDeg; // eq. 8 and 9
+
+/** A unit normal facing the sensor, tilted by \a degrees about the y axis. */
+Eigen::Vector3f
+tilted(double degrees)
+{
+  return Eigen::Vector3d(std::sin(degrees * kDeg), 0.0, -std::cos(degrees * kDeg))
+      .cast<float>();
+}
+
+double
+angleDeg(const Eigen::Vector3f& a, const Eigen::Vector3f& b)
+{
+  const double c = a.cast<double>().normalized().dot(b.cast<double>().normalized());
+  return std::acos(std::max(-1.0, std::min(1.0, c))) / kDeg;
+}
+
+/** A strip of 2 x n vertices. Column c holds vertices 2c and 2c + 1; triangles
+ * (2c, 2c + 1, 2c + 2) and (2c + 1, 2c + 3, 2c + 2), numbered 2c and 2c + 1, join it to
+ * column c + 1. Each column belongs to one leaf (-1: none). A triangle within one leaf
+ * gets the leaf's normal, a triangle between two leaves the normal half way between. */
+struct Strip {
+  Vector3fVector leaf_normals;
+  std::vector<double> leaf_areas;
+  std::vector<pcl::index_t> vertex_leaf;
+  std::vector<Triangle> triangles;
+  Vector3fVector triangle_normals;
+  std::vector<std::uint8_t> edge_on;
+
+  Strip(const std::vector<pcl::index_t>& column_leaf,
+        const std::vector<double>& leaf_degrees,
+        const std::vector<double>& areas)
+      : leaf_areas(areas)
+  {
+    for (const double d : leaf_degrees)
+      leaf_normals.push_back(tilted(d));
+    for (const auto leaf : column_leaf) {
+      vertex_leaf.push_back(leaf);
+      vertex_leaf.push_back(leaf);
+    }
+    for (pcl::index_t c = 0; c + 1 < static_cast<pcl::index_t>(column_leaf.size());
+         ++c) {
+      triangles.push_back({2 * c, 2 * c + 1, 2 * c + 2});
+      triangles.push_back({2 * c + 1, 2 * c + 3, 2 * c + 2});
+      const auto a = column_leaf[c], b = column_leaf[c + 1];
+      double degrees = 0.0;
+      if (a >= 0 && b >= 0)
+        degrees = 0.5 * (leaf_degrees[a] + leaf_degrees[b]);
+      else if (a >= 0 || b >= 0)
+        degrees = leaf_degrees[std::max(a, b)];
+      triangle_normals.push_back(tilted(degrees));
+      triangle_normals.push_back(tilted(degrees));
+    }
+    edge_on.assign(triangles.size(), 0);
+  }
+
+  /** Set the normal of the two triangles between columns c and c + 1. */
+  void setJoinNormal(std::size_t c, const Eigen::Vector3f& normal)
+  {
+    triangle_normals[2 * c] = normal;
+    triangle_normals[2 * c + 1] = normal;
+  }
+
+  MergeInput input() const
+  {
+    MergeInput in;
+    in.leaf_normals = &leaf_normals;
+    in.leaf_areas = &leaf_areas;
+    in.vertex_leaf = &vertex_leaf;
+    in.triangles = &triangles;
+    in.triangle_normals = &triangle_normals;
+    in.triangle_edge_on = &edge_on;
+    in.max_merge_angle = kThreshold;
+    in.max_edge_triangle_angle = kThreshold;
+    return in;
+  }
+};
+
+struct Merged {
+  std::vector<pcl::index_t> leaf_segment;
+  Vector3fVector segment_normals;
+};
+
+Merged
+merge(const MergeInput& in)
+{
+  Merged m;
+  mergeSeedSegments(in, m.leaf_segment, m.segment_normals);
+  EXPECT_EQ(m.leaf_segment.size(), in.leaf_normals->size());
+  for (const auto s : m.leaf_segment) {
+    EXPECT_GE(s, 0);
+    EXPECT_LT(s, static_cast<pcl::index_t>(m.segment_normals.size()));
+  }
+  for (const auto& n : m.segment_normals)
+    EXPECT_NEAR(n.norm(), 1.0f, 1e-5f);
+  return m;
+}
+
+using Segments = std::vector<pcl::index_t>;
+
+} // namespace
+
+TEST(Incidence, Build)
+{
+  // Items 0..5 in groups {2, none, 0, 2, 1, 0}, 4 groups (group 3 empty).
+  const Incidence inc = Incidence::build({2, -1, 0, 2, 1, 0}, 4);
+  EXPECT_EQ(inc.offsets, (std::vector<std::size_t>{0, 2, 3, 5, 5}));
+  EXPECT_EQ(inc.items, (std::vector<pcl::index_t>{2, 5, 4, 0, 3}));
+
+  const Incidence empty = Incidence::build({-1, -1}, 2);
+  EXPECT_EQ(empty.offsets, (std::vector<std::size_t>{0, 0, 0}));
+  EXPECT_TRUE(empty.items.empty());
+}
+
+TEST(Incidence, VertexTriangles)
+{
+  // Vertex 5 is isolated.
+  const std::vector<Triangle> triangles{{0, 1, 2}, {2, 1, 3}, {3, 4, 2}};
+  const Incidence inc = vertexTriangles(triangles, 6);
+  EXPECT_EQ(inc.offsets, (std::vector<std::size_t>{0, 1, 3, 6, 8, 9, 9}));
+  EXPECT_EQ(inc.items, (std::vector<pcl::index_t>{0, 0, 1, 0, 1, 2, 1, 2, 2}));
+}
+
+TEST(MergeSeedSegments, SimilarSeedsMergeAcrossValidEdge)
+{
+  // Seeds 10 degrees apart with equal areas; the joining triangles at 5 degrees.
+  const Strip strip({0, 0, 1, 1}, {0.0, 10.0}, {1.0, 1.0});
+  const Merged m = merge(strip.input());
+  EXPECT_EQ(m.leaf_segment, (Segments{0, 0}));
+  ASSERT_EQ(m.segment_normals.size(), 1u);
+  // Equal weights: the normalized sum of the two is the bisector, 5 degrees.
+  EXPECT_NEAR(angleDeg(m.segment_normals[0], tilted(5.0)), 0.0, 1e-3);
+}
+
+TEST(MergeSeedSegments, DissimilarSeedsStaySeparate)
+{
+  // eq. 9: 30 degrees > 25. The joining triangles (15 degrees) are valid for both.
+  const Strip strip({0, 0, 1, 1}, {0.0, 30.0}, {1.0, 1.0});
+  const Merged m = merge(strip.input());
+  EXPECT_EQ(m.leaf_segment, (Segments{0, 1}));
+  ASSERT_EQ(m.segment_normals.size(), 2u);
+  EXPECT_NEAR(angleDeg(m.segment_normals[0], tilted(0.0)), 0.0, 1e-3);
+  EXPECT_NEAR(angleDeg(m.segment_normals[1], tilted(30.0)), 0.0, 1e-3);
+}
+
+TEST(MergeSeedSegments, MergeAngleThreshold)
+{
+  EXPECT_EQ(merge(Strip({0, 0, 1, 1}, {0.0, 24.0}, {1.0, 1.0}).input()).leaf_segment,
+            (Segments{0, 0}));
+  EXPECT_EQ(merge(Strip({0, 0, 1, 1}, {0.0, 26.0}, {1.0, 1.0}).input()).leaf_segment,
+            (Segments{0, 1}));
+  // A larger threshold merges the 30-degree pair of the previous test.
+  Strip strip({0, 0, 1, 1}, {0.0, 30.0}, {1.0, 1.0});
+  MergeInput in = strip.input();
+  in.max_merge_angle = 35.0 * kDeg;
+  EXPECT_EQ(merge(in).leaf_segment, (Segments{0, 0}));
+}
+
+TEST(MergeSeedSegments, InvalidEdgeTriangleBlocks)
+{
+  // eq. 8: seeds 10 degrees apart, but the only triangles joining them are 40 degrees
+  // from the first (and 30 from the second).
+  Strip strip({0, 0, 1, 1}, {0.0, 10.0}, {1.0, 1.0});
+  strip.setJoinNormal(1, tilted(40.0));
+  Merged m = merge(strip.input());
+  EXPECT_EQ(m.leaf_segment, (Segments{0, 1}));
+  EXPECT_EQ(m.segment_normals.size(), 2u);
+
+  // 20 degrees: within 25 of the first seed's normal, a valid edge.
+  strip.setJoinNormal(1, tilted(20.0));
+  EXPECT_EQ(merge(strip.input()).leaf_segment, (Segments{0, 0}));
+
+  // One valid triangle among the joining ones suffices.
+  strip.setJoinNormal(1, tilted(40.0));
+  strip.triangle_normals[3] = tilted(5.0);
+  EXPECT_EQ(merge(strip.input()).leaf_segment, (Segments{0, 0}));
+
+  // A degenerate (NaN) joining triangle is never valid.
+  strip.setJoinNormal(
+      1, Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN()));
+  EXPECT_EQ(merge(strip.input()).leaf_segment, (Segments{0, 1}));
+}
+
+TEST(MergeSeedSegments, EdgeOnTriangleBlocks)
+{
+  Strip strip({0, 0, 1, 1}, {0.0, 10.0}, {1.0, 1.0});
+  strip.edge_on[2] = strip.edge_on[3] = 1;
+  EXPECT_EQ(merge(strip.input()).leaf_segment, (Segments{0, 1}));
+  // Without the flags (or without the optional array) they merge.
+  MergeInput in = strip.input();
+  in.triangle_edge_on = nullptr;
+  EXPECT_EQ(merge(in).leaf_segment, (Segments{0, 0}));
+  strip.edge_on[2] = 0;
+  EXPECT_EQ(merge(strip.input()).leaf_segment, (Segments{0, 0}));
+}
+
+TEST(MergeSeedSegments, LargestSeedStartsFirstSegment)
+{
+  // Leaf 1 holds 8 vertices, leaf 0 two: leaf 1 starts segment 0.
+  Merged m = merge(Strip({0, 1, 1, 1, 1}, {0.0, 30.0}, {1.0, 1.0}).input());
+  EXPECT_EQ(m.leaf_segment, (Segments{1, 0}));
+  ASSERT_EQ(m.segment_normals.size(), 2u);
+  EXPECT_NEAR(angleDeg(m.segment_normals[0], tilted(30.0)), 0.0, 1e-3);
+
+  // Equal sizes: the smaller leaf index first, wherever it lies in the mesh.
+  m = merge(Strip({1, 1, 0, 0}, {0.0, 30.0}, {1.0, 1.0}).input());
+  EXPECT_EQ(m.leaf_segment, (Segments{0, 1}));
+  EXPECT_NEAR(angleDeg(m.segment_normals[0], tilted(0.0)), 0.0, 1e-3);
+}
+
+TEST(MergeSeedSegments, OrderDecidesTheChain)
+{
+  // Seeds A = 0, B = 20, C = 40 degrees, joined A-B-C, equal areas.
+  // B largest: B's normal is 20 degrees from both A and C; A is met first (its columns
+  // come first), giving N = bisector of 0 and 20 = 10 degrees, 30 from C: {A, B}, {C}.
+  Merged m = merge(
+      Strip({0, 0, 1, 1, 1, 1, 2, 2}, {0.0, 20.0, 40.0}, {1.0, 1.0, 1.0}).input());
+  EXPECT_EQ(m.leaf_segment, (Segments{0, 0, 1}));
+  // C largest: C takes B (20 degrees), N = 30 degrees, 30 from A: {B, C}, {A}.
+  m = merge(
+      Strip({0, 0, 1, 1, 2, 2, 2, 2}, {0.0, 20.0, 40.0}, {1.0, 1.0, 1.0}).input());
+  EXPECT_EQ(m.leaf_segment, (Segments{1, 0, 0}));
+  ASSERT_EQ(m.segment_normals.size(), 2u);
+  EXPECT_NEAR(angleDeg(m.segment_normals[0], tilted(30.0)), 0.0, 1e-3);
+  EXPECT_NEAR(angleDeg(m.segment_normals[1], tilted(0.0)), 0.0, 1e-3);
+}
+
+TEST(MergeSeedSegments, SegmentNormalIsInverseAreaWeightedMean)
+{
+  // eq. 7: seeds at 0 degrees (A_v = 1) and 20 degrees (A_v = 4).
+  // N' = (0, 0, -1) / 1 + (sin 20, 0, -cos 20) / 4 = (0.0855050, 0, -1.2349232):
+  // 3.96 degrees from the first seed (an unweighted mean would give 10, an
+  // area-weighted one 16).
+  const Strip strip({0, 0, 1, 1}, {0.0, 20.0}, {1.0, 4.0});
+  const Merged m = merge(strip.input());
+  EXPECT_EQ(m.leaf_segment, (Segments{0, 0}));
+  ASSERT_EQ(m.segment_normals.size(), 1u);
+  const Eigen::Vector3f expected =
+      Eigen::Vector3f(0.0855050f, 0.0f, -1.2349232f).normalized();
+  EXPECT_NEAR(m.segment_normals[0].x(), expected.x(), 1e-5f);
+  EXPECT_NEAR(m.segment_normals[0].y(), expected.y(), 1e-5f);
+  EXPECT_NEAR(m.segment_normals[0].z(), expected.z(), 1e-5f);
+  EXPECT_NEAR(angleDeg(m.segment_normals[0], tilted(0.0)), 3.961, 1e-2);
+}
+
+TEST(MergeSeedSegments, RunningSegmentNormal)
+{
+  // A chain of seeds at 0, 15, 30 and 45 degrees, equal areas; the first is the
+  // largest. Seed 1 (15 from N = 0) joins: N = bisector = 7.5. Seed 2 is 22.5 from 7.5
+  // and joins: N = normalize(n0 + n15 + n30) = 15 by symmetry. Seed 3 is 30 from 15: it
+  // stays out, although it is within 25 degrees of its neighbour seed 2.
+  const Strip strip(
+      {0, 0, 0, 0, 1, 1, 2, 2, 3, 3}, {0.0, 15.0, 30.0, 45.0}, {1, 1, 1, 1});
+  const Merged m = merge(strip.input());
+  EXPECT_EQ(m.leaf_segment, (Segments{0, 0, 0, 1}));
+  ASSERT_EQ(m.segment_normals.size(), 2u);
+  EXPECT_NEAR(angleDeg(m.segment_normals[0], tilted(15.0)), 0.0, 1e-3);
+  EXPECT_NEAR(angleDeg(m.segment_normals[1], tilted(45.0)), 0.0, 1e-3);
+}
+
+TEST(MergeSeedSegments, SeedsWithoutSharedTrianglesStaySeparate)
+{
+  // Identical normals, but an unassigned column lies between the two seeds: no triangle
+  // has vertices in both.
+  const Strip strip({0, 0, -1, 1, 1}, {0.0, 0.0}, {1.0, 1.0});
+  const Merged m = merge(strip.input());
+  EXPECT_EQ(m.leaf_segment, (Segments{0, 1}));
+}
+
+TEST(MergeSeedSegments, TriangleOverThreeSeeds)
+{
+  // One triangle whose vertices lie in three one-vertex seeds; a fourth seed has no
+  // vertex at all and still gets a segment of its own.
+  const Vector3fVector leaf_normals{
+      tilted(0.0), tilted(10.0), tilted(-10.0), tilted(0.0)};
+  const std::vector<double> leaf_areas{1.0, 1.0, 1.0, 1.0};
+  const std::vector<pcl::index_t> vertex_leaf{0, 1, 2};
+  const std::vector<Triangle> triangles{{0, 1, 2}};
+  const Vector3fVector triangle_normals{tilted(0.0)};
+  MergeInput in;
+  in.leaf_normals = &leaf_normals;
+  in.leaf_areas = &leaf_areas;
+  in.vertex_leaf = &vertex_leaf;
+  in.triangles = &triangles;
+  in.triangle_normals = &triangle_normals;
+  in.max_merge_angle = kThreshold;
+  in.max_edge_triangle_angle = kThreshold;
+  const Merged m = merge(in);
+  EXPECT_EQ(m.leaf_segment, (Segments{0, 0, 0, 1}));
+  ASSERT_EQ(m.segment_normals.size(), 2u);
+  EXPECT_NEAR(angleDeg(m.segment_normals[0], tilted(0.0)), 0.0, 1e-3);
+}
+
+TEST(ClassifyTriangles, Classes)
+{
+  // Label 1: normal 0 degrees; label 2: 40 degrees; label 3: -60 degrees.
+  const Vector3fVector label_normals{tilted(0.0), tilted(40.0), tilted(-60.0)};
+  const std::vector<std::uint32_t> vertex_labels{1, 1, 1, 2, 2, 0, 0, 3};
+  const std::vector<Triangle> triangles{
+      {0, 1, 2}, // interior of 1
+      {0, 1, 3}, // 1 and 2, normal 30: 10 from label 2 -> valid edge of 2
+      {0, 3, 4}, // 1 and 2, normal 5: 5 from label 1 -> valid edge of 1
+      {1, 2, 3}, // 1 and 2, normal -30: 30 from 1, 70 from 2 -> invalid, label 1
+      {0, 3, 1}, // 1 and 2, normal 38 but seen edge-on -> invalid, label 2
+      {5, 6, 5}, // no label
+      {5, 6, 7}, // only label 3, normal -55 -> valid edge of 3
+      {3, 4, 5}, // 2 and unlabeled, normal 40: not interior, valid edge of 2
+      {2, 3, 7}, // 1, 2 and 3, normal 100 -> invalid; closest is 2 (60 degrees)
+  };
+  const Vector3fVector normals{tilted(0.0),
+                               tilted(30.0),
+                               tilted(5.0),
+                               tilted(-30.0),
+                               tilted(38.0),
+                               tilted(0.0),
+                               tilted(-55.0),
+                               tilted(40.0),
+                               tilted(100.0)};
+  std::vector<std::uint8_t> edge_on(triangles.size(), 0);
+  edge_on[4] = 1;
+  std::vector<std::uint32_t> labels;
+  std::vector<TriangleClass> classes;
+  classifyTriangles(triangles,
+                    normals,
+                    &edge_on,
+                    vertex_labels,
+                    label_normals,
+                    kThreshold,
+                    labels,
+                    classes);
+  const std::vector<std::uint32_t> expected_labels{1, 2, 1, 1, 2, 0, 3, 2, 2};
+  const std::vector<TriangleClass> expected_classes{TriangleClass::Interior,
+                                                    TriangleClass::ValidEdge,
+                                                    TriangleClass::ValidEdge,
+                                                    TriangleClass::InvalidEdge,
+                                                    TriangleClass::InvalidEdge,
+                                                    TriangleClass::InvalidEdge,
+                                                    TriangleClass::ValidEdge,
+                                                    TriangleClass::ValidEdge,
+                                                    TriangleClass::InvalidEdge};
+  EXPECT_EQ(labels, expected_labels);
+  EXPECT_EQ(classes, expected_classes);
+
+  // Without the edge-on array triangle 4 is a valid edge of 2 (2 degrees).
+  classifyTriangles(triangles,
+                    normals,
+                    nullptr,
+                    vertex_labels,
+                    label_normals,
+                    kThreshold,
+                    labels,
+                    classes);
+  EXPECT_EQ(labels[4], 2u);
+  EXPECT_EQ(classes[4], TriangleClass::ValidEdge);
+}
+
+TEST(ClassifyTriangles, InteriorIgnoresNormal)
+{
+  // Interior triangles keep their label whatever their normal, even a NaN one.
+  const Vector3fVector label_normals{tilted(0.0)};
+  const std::vector<Triangle> triangles{{0, 1, 2}, {0, 2, 1}};
+  const Vector3fVector normals{
+      tilted(90.0), Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN())};
+  std::vector<std::uint32_t> labels;
+  std::vector<TriangleClass> classes;
+  classifyTriangles(triangles,
+                    normals,
+                    nullptr,
+                    {1, 1, 1},
+                    label_normals,
+                    kThreshold,
+                    labels,
+                    classes);
+  EXPECT_EQ(labels, (std::vector<std::uint32_t>{1, 1}));
+  EXPECT_EQ(classes[0], TriangleClass::Interior);
+  EXPECT_EQ(classes[1], TriangleClass::Interior);
+}
+
+TEST(ClassifyTriangles, DegenerateEdgeTriangleIsInvalid)
+{
+  const Vector3fVector label_normals{tilted(0.0), tilted(0.0)};
+  const std::vector<Triangle> triangles{{0, 1, 2}};
+  const Vector3fVector normals{
+      Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN())};
+  std::vector<std::uint32_t> labels;
+  std::vector<TriangleClass> classes;
+  classifyTriangles(triangles,
+                    normals,
+                    nullptr,
+                    {1, 2, 2},
+                    label_normals,
+                    kThreshold,
+                    labels,
+                    classes);
+  ASSERT_EQ(labels.size(), 1u);
+  EXPECT_TRUE(labels[0] == 1u || labels[0] == 2u) << labels[0];
+  EXPECT_EQ(classes[0], TriangleClass::InvalidEdge);
+}
+
+int
+main(int argc, char** argv)
+{
+  testing::InitGoogleTest(&argc, argv);
+  return RUN_ALL_TESTS();
+}
