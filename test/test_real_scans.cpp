@@ -5,25 +5,34 @@
  */
 
 // Real scans: the mOSD RGB-D frames with object-part ground truth, and PCL's stereo mug
-// scene. The data folder is the first argument; the tests skip when it is missing.
+// scene. Arguments: the shared data folder, then the repository's data/ folder (which
+// bundles the mug scene); a test skips when its file is in neither.
 
 #include <pcl_selective_seg/selective_segmentation.h>
 
 #include <gtest/gtest.h>
 #include <pcl/io/pcd_io.h>
 
+#include <fstream>
 #include <map>
 #include <string>
+#include <vector>
 
 namespace {
 
-std::string data_dir; // NOLINT: set once in main()
+std::string shared_dir;  // NOLINT: set once in main()
+std::string bundled_dir; // NOLINT: set once in main()
 
+/** Load the first of the candidate paths that exists and reads. */
 bool
-load(const std::string& relative, pcl::PointCloud<pcl::PointXYZL>& cloud)
+load(const std::vector<std::string>& paths, pcl::PointCloud<pcl::PointXYZL>& cloud)
 {
-  return !data_dir.empty() &&
-         pcl::io::loadPCDFile(data_dir + "/" + relative, cloud) == 0 && !cloud.empty();
+  for (const auto& path : paths) {
+    std::ifstream exists(path);
+    if (exists && pcl::io::loadPCDFile(path, cloud) == 0 && !cloud.empty())
+      return true;
+  }
+  return false;
 }
 
 /** Fraction of the labeled points that lie in a segment whose majority ground-truth
@@ -60,8 +69,8 @@ class MosdFrame : public ::testing::TestWithParam<const char*> {};
 TEST_P(MosdFrame, SegmentsDoNotLeakAcrossObjects)
 {
   auto cloud = pcl::make_shared<pcl::PointCloud<pcl::PointXYZL>>();
-  if (!load(std::string("mosd/") + GetParam() + ".pcd", *cloud))
-    GTEST_SKIP() << "mOSD frame not found under '" << data_dir << "'";
+  if (!load({shared_dir + "/mosd/" + GetParam() + ".pcd"}, *cloud))
+    GTEST_SKIP() << "mOSD frame not found under '" << shared_dir << "'";
   pcl::selective_seg::SelectiveSegmentation<pcl::PointXYZL> seg;
   seg.setInputCloud(cloud);
   std::vector<pcl::PointIndices> segments;
@@ -87,8 +96,9 @@ INSTANTIATE_TEST_SUITE_P(RealScans,
 TEST(StereoScan, MugSceneSegments)
 {
   auto cloud = pcl::make_shared<pcl::PointCloud<pcl::PointXYZL>>();
-  if (!load("pcl_test/table_scene_mug_stereo_textured.pcd", *cloud))
-    GTEST_SKIP() << "stereo mug scene not found under '" << data_dir << "'";
+  const std::string name = "table_scene_mug_stereo_textured.pcd";
+  if (!load({bundled_dir + "/" + name, shared_dir + "/pcl_test/" + name}, *cloud))
+    GTEST_SKIP() << "stereo mug scene not found in '" << bundled_dir << "'";
   pcl::selective_seg::SelectiveSegmentation<pcl::PointXYZL> seg;
   seg.setInputCloud(cloud);
   // The file's VIEWPOINT says the sensor is turned 180 degrees about x, which would put
@@ -112,6 +122,8 @@ main(int argc, char** argv)
 {
   testing::InitGoogleTest(&argc, argv);
   if (argc > 1)
-    data_dir = argv[1];
+    shared_dir = argv[1];
+  if (argc > 2)
+    bundled_dir = argv[2];
   return RUN_ALL_TESTS();
 }
