@@ -15,9 +15,9 @@
 #include <pcl/io/pcd_io.h>
 
 #include <cstdio>
-#include <map>
 #include <string>
 
+#include <leakage.h>
 #include <synthetic_scenes.h>
 
 namespace {
@@ -37,21 +37,7 @@ score(const pcl::PointCloud<pcl::PointXYZL>::ConstPtr& cloud, double incidence)
   Score s;
   if (!seg.extract(segments))
     return s;
-  std::size_t leaked = 0, total = 0;
-  for (const auto& c : segments) {
-    std::map<std::uint32_t, std::size_t> votes;
-    for (const auto i : c.indices)
-      if ((*cloud)[i].label != 0)
-        ++votes[(*cloud)[i].label];
-    std::size_t in = 0, majority = 0;
-    for (const auto& v : votes) {
-      in += v.second;
-      majority = std::max(majority, v.second);
-    }
-    leaked += in - majority;
-    total += in;
-  }
-  s.leakage = total ? static_cast<double>(leaked) / total : 0.0;
+  s.leakage = selseg_test::leakage(*cloud, segments);
   s.segments = segments.size();
   return s;
 }

@@ -14,9 +14,10 @@
 #include <pcl/io/pcd_io.h>
 
 #include <fstream>
-#include <map>
 #include <string>
 #include <vector>
+
+#include <leakage.h>
 
 namespace {
 
@@ -33,29 +34,6 @@ load(const std::vector<std::string>& paths, pcl::PointCloud<pcl::PointXYZL>& clo
       return true;
   }
   return false;
-}
-
-/** Fraction of the labeled points that lie in a segment whose majority ground-truth
- * label is not theirs (ground-truth 0, invalid, ignored). */
-double
-leakage(const pcl::PointCloud<pcl::PointXYZL>& truth,
-        const std::vector<pcl::PointIndices>& segments)
-{
-  std::size_t leaked = 0, total = 0;
-  for (const auto& s : segments) {
-    std::map<std::uint32_t, std::size_t> votes;
-    for (const auto i : s.indices)
-      if (truth[i].label != 0)
-        ++votes[truth[i].label];
-    std::size_t in_segment = 0, majority = 0;
-    for (const auto& v : votes) {
-      in_segment += v.second;
-      majority = std::max(majority, v.second);
-    }
-    leaked += in_segment - majority;
-    total += in_segment;
-  }
-  return total ? static_cast<double>(leaked) / total : 0.0;
 }
 
 } // namespace
@@ -81,7 +59,7 @@ TEST_P(MosdFrame, SegmentsDoNotLeakAcrossObjects)
   EXPECT_EQ(r.counts.non_finite + r.counts.labeled + r.counts.without_normal +
                 r.counts.behind_sensor,
             cloud->size());
-  EXPECT_LT(leakage(*cloud, segments), 0.005);
+  EXPECT_LT(selseg_test::leakage(*cloud, segments), 0.005);
   // The table top is the largest segment and almost all table.
   std::size_t table = 0;
   for (const auto i : segments[0].indices)
