@@ -1,0 +1,81 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
+ */
+
+#pragma once
+
+#include <pcl_selective_seg/parameters.h>
+#include <pcl_selective_seg/segmentation_result.h>
+
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace selseg_apps {
+
+/** \brief Output files written under temporary names and renamed into place only when
+ * all of them were written: a failed run leaves no partial or stale output behind. */
+class OutputTransaction {
+public:
+  OutputTransaction() = default;
+  OutputTransaction(const OutputTransaction&) = delete;
+  OutputTransaction& operator=(const OutputTransaction&) = delete;
+  /** \brief Removes the temporary files of an uncommitted transaction. */
+  ~OutputTransaction();
+
+  /** \brief The temporary path to write \a final_path's content to. */
+  std::string stage(const std::string& final_path);
+
+  /** \brief Rename every staged file to its final path.
+   * \param[out] error the failure, naming the file */
+  bool commit(std::string& error);
+
+private:
+  std::vector<std::pair<std::string, std::string>> files_; ///< (temporary, final)
+  bool committed_ = false;
+};
+
+// Each writer returns false when the file cannot be written completely.
+
+/** \brief The labeled cloud (x y z label), input size, order and layout, binary PCD. */
+bool writeLabeledCloud(const std::string& path,
+                       const pcl::PointCloud<pcl::PointXYZL>& cloud);
+
+/** \brief The segmented mesh as binary PLY: the vertices the triangles use, and per
+ * face its vertex indices, an RGB colour (segment hue; edge triangles white), its label
+ * and its class (0 interior, 1 valid edge, 2 invalid edge). */
+bool writeMeshPly(const std::string& path,
+                  const pcl::PointCloud<pcl::PointXYZ>& cloud,
+                  const pcl::selective_seg::SegmentedMesh& mesh);
+
+/** \brief The same mesh as legacy binary VTK polydata, with the colours, labels and
+ * classes as cell data. */
+bool writeMeshVtk(const std::string& path,
+                  const pcl::PointCloud<pcl::PointXYZ>& cloud,
+                  const pcl::selective_seg::SegmentedMesh& mesh);
+
+/** \brief The octree leaves as a PCD, one point per leaf: x y z (centre, cloud frame)
+ * size depth label normal_x normal_y normal_z sigma_theta sigma_phi num_points. */
+bool writeLeaves(const std::string& path,
+                 const std::vector<pcl::selective_seg::OctreeLeaf>& leaves);
+
+/** \brief What the JSON summary reports besides the result. */
+struct RunInfo {
+  std::string input;
+  std::size_t num_points = 0;
+  std::string backend;
+  pcl::selective_seg::SelectiveSegmentationParameters parameters;
+};
+
+/** \brief A JSON summary: input, parameters, counts, timings and every segment's size,
+ * normal, area and leaf count. */
+bool writeSummaryJson(const std::string& path,
+                      const RunInfo& info,
+                      const pcl::selective_seg::SegmentationResult& result);
+
+} // namespace selseg_apps

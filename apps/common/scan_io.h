@@ -1,0 +1,32 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
+ */
+
+#pragma once
+
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include <string>
+
+namespace selseg_apps {
+
+/** \brief Read a scan: PCD or PLY (any point type with x, y and z fields) or plain text
+ * with "x y z" per line (further columns ignored, '#' comments and blank lines
+ * skipped).
+ *
+ * The PCD's VIEWPOINT becomes the cloud's sensor_origin_ / sensor_orientation_; the
+ * organized layout (width x height) is kept.
+ * \param[in] path the file; its extension (.pcd, .ply, anything else = text) decides
+ * \param[in] unit_scale factor applied to every coordinate (0.01 for centimetres)
+ * \param[out] cloud the points, in input order
+ * \param[out] error what is wrong with the file and what to do, when false
+ * \return false when the file cannot be read or has no x, y, z */
+bool loadScan(const std::string& path,
+              double unit_scale,
+              pcl::PointCloud<pcl::PointXYZ>& cloud,
+              std::string& error);
+
+} // namespace selseg_apps

@@ -1,0 +1,208 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
+ */
+
+// End-to-end tests of the command-line tool: outputs, exit codes, no partial output.
+// Arguments: the tool's path, then the bundled scan.
+
+#include <gtest/gtest.h>
+#include <pcl/PCLPointCloud2.h>
+#include <pcl/common/io.h>
+#include <pcl/io/pcd_io.h>
+#include <pcl/io/ply_io.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <sys/wait.h>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string tool;  // NOLINT: set once in main()
+std::string scan;  // NOLINT: set once in main()
+
+/** Run the tool with arguments; its exit code. */
+int
+run(const std::string& args)
+{
+  const std::string command = "'" + tool + "' " + args + " > /dev/null 2>&1";
+  const int status = std::system(command.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+class Tool : public ::testing::Test {
+protected:
+  void
+  SetUp() override
+  {
+    if (tool.empty() || !fs::exists(tool) || !fs::exists(scan))
+      GTEST_SKIP() << "tool or scan missing";
+    dir = fs::temp_directory_path() /
+          ("selseg_tool_" + std::string(
+                                ::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+  }
+  void
+  TearDown() override
+  {
+    fs::remove_all(dir);
+  }
+  std::string
+  out(const std::string& name) const
+  {
+    return (dir / name).string();
+  }
+  std::size_t
+  files() const
+  {
+    return static_cast<std::size_t>(
+        std::distance(fs::directory_iterator(dir), fs::directory_iterator()));
+  }
+  fs::path dir;
+};
+
+/** The element count a PLY header declares. */
+std::size_t
+plyCount(const std::string& path, const std::string& element)
+{
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  while (std::getline(in, line) && line != "end_header") {
+    std::istringstream words(line);
+    std::string keyword, name;
+    std::size_t count = 0;
+    if (words >> keyword >> name >> count && keyword == "element" && name == element)
+      return count;
+  }
+  return 0;
+}
+
+} // namespace
+
+TEST_F(Tool, WritesEveryOutputInInputOrder)
+{
+  ASSERT_EQ(run("'" + scan + "' -ignore_viewpoint -o " + out("labels.pcd") +
+                " -mesh_ply " + out("mesh.ply") + " -mesh_vtk " + out("mesh.vtk") +
+                " -leaves " + out("leaves.pcd") + " -json " + out("summary.json")),
+            0);
+  pcl::PointCloud<pcl::PointXYZ> input;
+  pcl::PointCloud<pcl::PointXYZL> labeled;
+  ASSERT_EQ(pcl::io::loadPCDFile(scan, input), 0);
+  ASSERT_EQ(pcl::io::loadPCDFile(out("labels.pcd"), labeled), 0);
+  ASSERT_EQ(labeled.size(), input.size());
+  EXPECT_EQ(labeled.width, input.width);
+  EXPECT_EQ(labeled.height, input.height);
+  std::size_t labeled_points = 0;
+  for (std::size_t i = 0; i < input.size(); ++i) {
+    const bool finite = std::isfinite(input[i].z);
+    ASSERT_EQ(finite, std::isfinite(labeled[i].z)) << i;
+    if (finite)
+      ASSERT_EQ(labeled[i].getVector3fMap(), input[i].getVector3fMap()) << i;
+    else
+      ASSERT_EQ(labeled[i].label, 0u) << i;
+    labeled_points += labeled[i].label > 0;
+  }
+  EXPECT_EQ(labeled_points, 209280u);
+
+  // The JSON summary and the meshes agree on the counts.
+  std::ifstream json(out("summary.json"));
+  const std::string text((std::istreambuf_iterator<char>(json)), {});
+  EXPECT_NE(text.find("\"labeled\": 209280"), std::string::npos);
+  const auto at = text.find("\"triangles\": ");
+  ASSERT_NE(at, std::string::npos);
+  const std::size_t triangles = std::stoul(text.substr(at + 13));
+  EXPECT_EQ(plyCount(out("mesh.ply"), "face"), triangles);
+  EXPECT_GT(plyCount(out("mesh.ply"), "vertex"), 200000u);
+  pcl::PolygonMesh mesh;
+  ASSERT_EQ(pcl::io::loadPLYFile(out("mesh.ply"), mesh), 0);
+  EXPECT_EQ(mesh.polygons.size(), triangles);
+  std::ifstream vtk(out("mesh.vtk"));
+  std::string first_line;
+  std::getline(vtk, first_line);
+  EXPECT_EQ(first_line, "# vtk DataFile Version 3.0");
+
+  pcl::PCLPointCloud2 leaves;
+  ASSERT_EQ(pcl::io::loadPCDFile(out("leaves.pcd"), leaves), 0);
+  for (const char* field : {"x", "size", "depth", "label", "normal_x", "sigma_theta"})
+    EXPECT_GE(pcl::getFieldIndex(leaves, field), 0) << field;
+  EXPECT_GT(leaves.width * leaves.height, 1000u);
+  EXPECT_EQ(files(), 5u); // no temporary left behind
+}
+
+TEST_F(Tool, UnreadableInputIsARuntimeErrorWithNoOutput)
+{
+  EXPECT_EQ(run(out("missing.pcd") + " -o " + out("labels.pcd")), 1);
+  std::ofstream(out("broken.pcd")) << "not a point cloud\n";
+  EXPECT_EQ(run(out("broken.pcd") + " -o " + out("labels.pcd")), 1);
+  std::ofstream(out("broken.xyz")) << "1 2 3\n4 five 6\n";
+  EXPECT_EQ(run(out("broken.xyz") + " -o " + out("labels.pcd")), 1);
+  EXPECT_FALSE(fs::exists(out("labels.pcd")));
+  EXPECT_EQ(files(), 2u); // only the two broken inputs
+}
+
+TEST_F(Tool, NoUsablePointIsARuntimeError)
+{
+  // The file's VIEWPOINT puts every point behind the sensor.
+  EXPECT_EQ(run("'" + scan + "' -o " + out("labels.pcd")), 1);
+  EXPECT_EQ(files(), 0u);
+}
+
+TEST_F(Tool, BadOptionsAreUsageErrors)
+{
+  const std::string in = "'" + scan + "' -ignore_viewpoint -o " + out("labels.pcd");
+  EXPECT_EQ(run(in + " -split_deg abc"), 2);
+  EXPECT_EQ(run(in + " -merge_deg -5"), 2);
+  EXPECT_EQ(run(in + " -min_voxel_m nan"), 2);
+  EXPECT_EQ(run(in + " -backend cgal"), 2);
+  EXPECT_EQ(run(in + " -no_such_option"), 2);
+  EXPECT_EQ(run(in + " -sensor_origin 1,2"), 2);
+  EXPECT_EQ(run(in + " -unit_scale 0"), 2);
+  EXPECT_EQ(run(""), 2);
+  EXPECT_EQ(run("-h"), 0);
+  EXPECT_EQ(files(), 0u);
+}
+
+TEST_F(Tool, UnwritableOutputLeavesNothingBehind)
+{
+  EXPECT_EQ(run("'" + scan + "' -ignore_viewpoint -o " + out("labels.pcd") + " -json " +
+                out("no/such/folder/summary.json")),
+            1);
+  EXPECT_EQ(files(), 0u); // the labeled cloud was not renamed into place either
+}
+
+TEST_F(Tool, ReadsTextInCentimetres)
+{
+  std::ofstream text(out("wall.xyz"));
+  text << "# a wall 2 m in front of the sensor, in centimetres\n";
+  for (int r = 0; r < 30; ++r)
+    for (int c = 0; c < 30; ++c)
+      text << 2 * c - 30 << " " << 2 * r - 30 << " 200\n";
+  text.close();
+  ASSERT_EQ(run(out("wall.xyz") + " -unit_scale 0.01 -o " + out("labels.pcd") +
+                " -min_voxel_m 0.05"),
+            0);
+  pcl::PointCloud<pcl::PointXYZL> labeled;
+  ASSERT_EQ(pcl::io::loadPCDFile(out("labels.pcd"), labeled), 0);
+  ASSERT_EQ(labeled.size(), 900u);
+  EXPECT_FLOAT_EQ(labeled[0].z, 2.0f);
+  for (const auto& p : labeled)
+    EXPECT_EQ(p.label, 1u);
+}
+
+int
+main(int argc, char** argv)
+{
+  testing::InitGoogleTest(&argc, argv);
+  if (argc > 2) {
+    tool = argv[1];
+    scan = argv[2];
+  }
+  return RUN_ALL_TESTS();
+}
