@@ -65,6 +65,7 @@ const OptionSpec kOptions[] = {{"-o", true},
                                {"-min_voxel_m", true},
                                {"-voxel_factor", true},
                                {"-min_split_points", true},
+                               {"-normal_rings", true},
                                {"-max_depth", true},
                                {"-angle_step_rad", true},
                                {"-backend", true},
@@ -125,6 +126,9 @@ printHelp(const char* program)
   print_info("  -min_split_points N      voxels with fewer points are not split "
              "(default %d)\n",
              d.min_points_to_split);
+  print_info("  -normal_rings N          point normals over the N-ring of mesh "
+             "triangles; 1 = paper's eq. 2 (default %d)\n",
+             d.normal_rings);
   print_info("  -max_depth N             deepest octree level (default %d)\n",
              d.max_octree_depth);
   print_info("  -angle_step_rad X        angle quantization step [rad] (default %g)\n",
@@ -224,6 +228,7 @@ parseAlgorithm(int argc, char** argv, SelectiveSegmentationParameters& p)
       !parseNumber(argc, argv, "-min_voxel_m", p.min_voxel_size) ||
       !parseNumber(argc, argv, "-voxel_factor", p.min_voxel_size_factor) ||
       !parseNumber(argc, argv, "-min_split_points", p.min_points_to_split) ||
+      !parseNumber(argc, argv, "-normal_rings", p.normal_rings) ||
       !parseNumber(argc, argv, "-max_depth", p.max_octree_depth) ||
       !parseNumber(argc, argv, "-angle_step_rad", p.angle_quantization))
     return false;

@@ -353,6 +353,37 @@ TEST(MeshNormals, EdgeOnRightAngleFlagsOnlyDegenerate)
   }
 }
 
+// A strip of four triangles along x: 0-1-2, 1-3-2, 2-3-4, 3-5-4 (vertices 0, 2, 4 at
+// y = 0 and 1, 3, 5 at y = 1). Triangle normals are given directly; areas all 1 except
+// the last (area 4).
+TEST(MeshNormals, RingNeighbourhoodsWidenEqTwo)
+{
+  using namespace pcl::selective_seg;
+  const std::vector<Triangle> tris{{0, 1, 2}, {1, 3, 2}, {2, 3, 4}, {3, 5, 4}};
+  const Vector3fVector n{Eigen::Vector3f(0, 0, -1),
+                         Eigen::Vector3f(0, 0, -1),
+                         Eigen::Vector3f(1, 0, 0),
+                         Eigen::Vector3f(0, 1, 0)};
+  const std::vector<double> areas{1.0, 1.0, 1.0, 4.0};
+  Vector3fVector one_ring, rings1, rings2;
+  std::vector<double> vertex_areas;
+  computeVertexNormals(6, tris, n, areas, one_ring, vertex_areas);
+  computeVertexNormalsOverRings(6, tris, n, areas, 1, rings1);
+  computeVertexNormalsOverRings(6, tris, n, areas, 2, rings2);
+  // rings = 1 is eq. 2 exactly.
+  for (int v = 0; v < 6; ++v)
+    EXPECT_TRUE(rings1[v].isApprox(one_ring[v], 1e-6f)) << v;
+  // Vertex 0: one ring = triangle 0 only; two rings add the triangles at vertices 1
+  // and 2 (triangles 1 and 2), so the sum is 2 (0,0,-1) + (1,0,0).
+  EXPECT_TRUE(one_ring[0].isApprox(Eigen::Vector3f(0, 0, -1), 1e-6f));
+  EXPECT_TRUE(rings2[0].isApprox(Eigen::Vector3f(1, 0, -2).normalized(), 1e-6f));
+  // Vertex 5: one ring = triangle 3 (weight 1/4); two rings add triangles 1 and 2 (at
+  // vertices 3 and 4): (0, 1/4, 0) + (0, 0, -1) + (1, 0, 0).
+  EXPECT_TRUE(rings2[5].isApprox(Eigen::Vector3f(1, 0.25f, -1).normalized(), 1e-6f));
+  // A triangle two rings away is not counted twice: vertex 2 sees all four.
+  EXPECT_TRUE(rings2[2].isApprox(Eigen::Vector3f(1, 0.25f, -2).normalized(), 1e-6f));
+}
+
 TEST(MeshNormals, MedianEdgeLength)
 {
   // t0 has edges 1, 2 and sqrt 5; alone its median is 2.

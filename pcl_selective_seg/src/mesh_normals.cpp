@@ -5,6 +5,7 @@
  */
 
 #include <pcl_selective_seg/mesh_normals.h>
+#include <pcl_selective_seg/region_merging.h>
 
 #include <algorithm>
 #include <cmath>
@@ -12,6 +13,29 @@
 
 namespace pcl {
 namespace selective_seg {
+
+namespace {
+
+/** The weight of a triangle in eq. 2, or 0 when it is degenerate. */
+double
+normalWeight(double area, const Eigen::Vector3f& normal)
+{
+  const double w = 1.0 / area;
+  return std::isfinite(area) && area > 0.0 && std::isfinite(w) && normal.allFinite()
+             ? w
+             : 0.0;
+}
+
+Eigen::Vector3f
+normalizedOrNaN(const Eigen::Vector3d& sum)
+{
+  const double norm = sum.norm();
+  if (norm > 0.0 && std::isfinite(norm))
+    return (sum / norm).cast<float>();
+  return Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN());
+}
+
+} // namespace
 
 void
 computeTriangleNormals(const Vector3fVector& positions,
@@ -51,23 +75,59 @@ computeVertexNormals(std::size_t num_vertices,
   std::vector<Eigen::Vector3d> sums(num_vertices, Eigen::Vector3d::Zero());
   vertex_areas.assign(num_vertices, 0.0);
   for (std::size_t t = 0; t < triangles.size(); ++t) {
-    const double area = areas[t];
-    const double weight = 1.0 / area; // eq. 2
-    const bool usable = std::isfinite(area) && area > 0.0 && std::isfinite(weight) &&
-                        normals[t].allFinite();
+    const double weight = normalWeight(areas[t], normals[t]); // eq. 2
     for (const auto v : triangles[t]) {
-      if (std::isfinite(area))
-        vertex_areas[v] += area; // eq. 3
-      if (usable)
+      if (std::isfinite(areas[t]))
+        vertex_areas[v] += areas[t]; // eq. 3
+      if (weight > 0.0)              // degenerate triangles are skipped (NaN normals)
         sums[v] += weight * normals[t].cast<double>();
     }
   }
-  const float nan = std::numeric_limits<float>::quiet_NaN();
-  vertex_normals.assign(num_vertices, Eigen::Vector3f::Constant(nan));
-  for (std::size_t v = 0; v < num_vertices; ++v) {
-    const double norm = sums[v].norm();
-    if (norm > 0.0 && std::isfinite(norm))
-      vertex_normals[v] = (sums[v] / norm).cast<float>();
+  vertex_normals.resize(num_vertices);
+  for (std::size_t v = 0; v < num_vertices; ++v)
+    vertex_normals[v] = normalizedOrNaN(sums[v]);
+}
+
+void
+computeVertexNormalsOverRings(std::size_t num_vertices,
+                              const std::vector<Triangle>& triangles,
+                              const Vector3fVector& normals,
+                              const std::vector<double>& areas,
+                              int rings,
+                              Vector3fVector& vertex_normals)
+{
+  const Incidence incident = vertexTriangles(triangles, num_vertices);
+  // Visit stamps: a vertex or triangle is in the current neighbourhood when its stamp
+  // equals the current vertex id + 1.
+  std::vector<std::size_t> vertex_stamp(num_vertices, 0),
+      triangle_stamp(triangles.size(), 0);
+  std::vector<pcl::index_t> frontier, next;
+  vertex_normals.resize(num_vertices);
+  for (std::size_t p = 0; p < num_vertices; ++p) {
+    const std::size_t stamp = p + 1;
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    frontier.assign(1, static_cast<pcl::index_t>(p));
+    vertex_stamp[p] = stamp;
+    for (int ring = 0; ring < rings && !frontier.empty(); ++ring) {
+      next.clear();
+      for (const auto v : frontier)
+        for (auto i = incident.offsets[v]; i < incident.offsets[v + 1]; ++i) {
+          const auto t = incident.items[i];
+          if (triangle_stamp[t] == stamp)
+            continue;
+          triangle_stamp[t] = stamp;
+          const double weight = normalWeight(areas[t], normals[t]);
+          if (weight > 0.0)
+            sum += weight * normals[t].cast<double>();
+          for (const auto u : triangles[t])
+            if (vertex_stamp[u] != stamp) {
+              vertex_stamp[u] = stamp;
+              next.push_back(u);
+            }
+        }
+      frontier.swap(next);
+    }
+    vertex_normals[p] = normalizedOrNaN(sum);
   }
 }
 

@@ -46,6 +46,8 @@ SelectiveSegmentationParameters::validate(std::string* why) const
       max_view_incidence_angle == 0.0)
     return reject(
         why, "max_view_incidence_angle [rad]", max_view_incidence_angle, "(0, pi/2]");
+  if (normal_rings < 1 || normal_rings > 10)
+    return reject(why, "normal_rings", normal_rings, "[1, 10]");
   if (!std::isfinite(min_voxel_size) || min_voxel_size < 0.0)
     return reject(why, "min_voxel_size [m]", min_voxel_size, "0 (automatic) or > 0");
   if (!inRange(min_voxel_size_factor, 0.5, 1000.0))

@@ -56,6 +56,27 @@ PCL_EXPORTS void computeVertexNormals(std::size_t num_vertices,
                                       Vector3fVector& vertex_normals,
                                       std::vector<double>& vertex_areas);
 
+/** \brief Point normals over a wider neighbourhood: eq. 2 summed over the triangles of
+ * the k-ring of each vertex instead of its one ring.
+ *
+ * N_p = normalize(sum over the triangles with a vertex at most rings - 1 edges from p
+ * of N_t / A_t). rings = 1 is eq. 2 exactly. The 1 / area weights keep triangles that
+ * span depth jumps (huge in 3-D) from blurring the normals across occlusion edges.
+ *
+ * \param[in] num_vertices #V
+ * \param[in] triangles #T triangles over vertex ids
+ * \param[in] normals #T triangle normals
+ * \param[in] areas #T triangle areas [m^2]
+ * \param[in] rings k >= 1
+ * \param[out] vertex_normals #V unit normals; NaN where no valid triangle is found
+ */
+PCL_EXPORTS void computeVertexNormalsOverRings(std::size_t num_vertices,
+                                               const std::vector<Triangle>& triangles,
+                                               const Vector3fVector& normals,
+                                               const std::vector<double>& areas,
+                                               int rings,
+                                               Vector3fVector& vertex_normals);
+
 /** \brief Flag the triangles seen edge-on from the viewpoint.
  *
  * A triangle whose normal makes more than \a max_incidence with the line of sight to

@@ -42,6 +42,12 @@ struct PCL_EXPORTS SelectiveSegmentationParameters {
    * the paper, measured in docs/parameters.md. Valid: (0, pi/2]. */
   double max_view_incidence_angle = 85.0 * M_PI / 180.0;
 
+  /** \brief Size of the neighbourhood of the point normals, in mesh rings: 1 is the
+   * paper's eq. 2 (the triangles at the point); k sums eq. 2's terms over the triangles
+   * of the k-ring, which averages range noise over about k^2 times more triangles.
+   * Valid: [1, 10]. See docs/parameters.md. */
+  int normal_rings = 1;
+
   /** \brief Smallest octree voxel edge [m]; voxels of this size are never split.
    * 0 = automatic: min_voxel_size_factor times the median 3-D edge length of the
    * Delaunay mesh (the median point spacing). Valid: 0 or a positive finite value. */

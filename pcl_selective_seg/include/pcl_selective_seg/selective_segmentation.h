@@ -93,6 +93,10 @@ public:
   }
   double getMaxViewIncidenceAngle() const { return params_.max_view_incidence_angle; }
 
+  /** \brief Neighbourhood of the point normals in mesh rings; 1 = the paper's eq. 2. */
+  void setNormalRings(int rings) { params_.normal_rings = rings; }
+  int getNormalRings() const { return params_.normal_rings; }
+
   /** \brief Smallest voxel edge [m]; 0 = automatic (see the parameters). */
   void setMinVoxelSize(double size) { params_.min_voxel_size = size; }
   double getMinVoxelSize() const { return params_.min_voxel_size; }

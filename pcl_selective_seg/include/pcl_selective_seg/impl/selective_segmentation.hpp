@@ -111,6 +111,13 @@ SelectiveSegmentation<PointT>::computeNormals()
                        triangle_areas_,
                        vertex_normals_,
                        *vertex_areas_);
+  if (params_.normal_rings > 1)
+    computeVertexNormalsOverRings(positions.size(),
+                                  tri.triangles,
+                                  triangle_normals_,
+                                  triangle_areas_,
+                                  params_.normal_rings,
+                                  vertex_normals_);
   const float nan = std::numeric_limits<float>::quiet_NaN();
   normals_.reset(
       new NormalCloud(input_->width, input_->height, pcl::Normal(nan, nan, nan, nan)));
