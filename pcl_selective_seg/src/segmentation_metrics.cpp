@@ -1,0 +1,497 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
+ */
+
+#include <pcl_selective_seg/segmentation_metrics.h>
+
+#include <pcl/common/point_tests.h>
+#include <pcl/console/print.h>
+#include <pcl/search/kdtree.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+namespace pcl {
+namespace selective_seg {
+namespace metrics {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+/** count >= fraction * total, with a margin of 1e-9 * total for the rounding of the
+ * fraction (see the namespace documentation). */
+bool
+atLeast(std::size_t count, double fraction, std::size_t total)
+{
+  const auto t = static_cast<double>(total);
+  return static_cast<double>(count) >= fraction * t - 1e-9 * t;
+}
+
+double
+ratio(std::size_t numerator, std::size_t denominator)
+{
+  return denominator == 0
+             ? kNaN
+             : static_cast<double>(numerator) / static_cast<double>(denominator);
+}
+
+bool
+inUnitInterval(double value)
+{
+  return value > 0.0 && value <= 1.0;
+}
+
+std::vector<std::uint32_t>
+sortedUnique(std::vector<std::uint32_t> labels)
+{
+  std::sort(labels.begin(), labels.end());
+  labels.erase(std::unique(labels.begin(), labels.end()), labels.end());
+  return labels;
+}
+
+std::size_t
+indexOf(const std::vector<std::uint32_t>& sorted_labels, std::uint32_t label)
+{
+  return static_cast<std::size_t>(
+      std::lower_bound(sorted_labels.begin(), sorted_labels.end(), label) -
+      sorted_labels.begin());
+}
+
+/** Distinct GT labels of the valid points and distinct predicted labels among them. */
+void
+collectLabels(const std::vector<std::uint32_t>& predicted,
+              const std::vector<std::uint32_t>& ground_truth,
+              LabelOverlap& overlap)
+{
+  std::vector<std::uint32_t> gt;
+  std::vector<std::uint32_t> pred;
+  gt.reserve(ground_truth.size());
+  pred.reserve(ground_truth.size());
+  for (std::size_t i = 0; i < ground_truth.size(); ++i) {
+    if (ground_truth[i] == 0)
+      continue;
+    gt.push_back(ground_truth[i]);
+    if (predicted[i] != 0)
+      pred.push_back(predicted[i]);
+  }
+  overlap.gt_labels = sortedUnique(std::move(gt));
+  overlap.predicted_labels = sortedUnique(std::move(pred));
+}
+
+/** Run-length encode sorted (gt << 32 | predicted) keys into entries. */
+std::vector<OverlapEntry>
+entriesFromKeys(std::vector<std::uint64_t>& keys)
+{
+  std::sort(keys.begin(), keys.end());
+  std::vector<OverlapEntry> entries;
+  for (std::size_t i = 0; i < keys.size();) {
+    std::size_t j = i;
+    while (j < keys.size() && keys[j] == keys[i])
+      ++j;
+    entries.push_back({static_cast<std::size_t>(keys[i] >> 32),
+                       static_cast<std::size_t>(keys[i] & 0xffffffffu),
+                       j - i});
+    i = j;
+  }
+  return entries;
+}
+
+bool
+validTolerance(double tolerance)
+{
+  return tolerance >= 0.5 && tolerance <= 1.0;
+}
+
+/** Per GT region (over = true): whether it is over-segmented; per predicted region
+ * (over = false): whether it under-segments. The parts of region r are the regions
+ * holding at least T of their own points in r; r is an instance when it has two or
+ * more parts and they hold at least T of r's points. */
+std::vector<char>
+groupInstances(const LabelOverlap& overlap, double tolerance, bool over)
+{
+  const auto& own_sizes = over ? overlap.gt_sizes : overlap.predicted_sizes;
+  const auto& part_sizes = over ? overlap.predicted_sizes : overlap.gt_sizes;
+  std::vector<std::size_t> parts(own_sizes.size(), 0);
+  std::vector<std::size_t> sums(own_sizes.size(), 0);
+  for (const auto& e : overlap.entries) {
+    const std::size_t own = over ? e.gt : e.predicted;
+    const std::size_t part = over ? e.predicted : e.gt;
+    if (atLeast(e.count, tolerance, part_sizes[part])) {
+      ++parts[own];
+      sums[own] += e.count;
+    }
+  }
+  std::vector<char> instance(own_sizes.size(), 0);
+  for (std::size_t r = 0; r < own_sizes.size(); ++r)
+    instance[r] = parts[r] >= 2 && atLeast(sums[r], tolerance, own_sizes[r]);
+  return instance;
+}
+
+} // namespace
+
+bool
+buildLabelOverlap(const std::vector<std::uint32_t>& predicted,
+                  const std::vector<std::uint32_t>& ground_truth,
+                  LabelOverlap& overlap)
+{
+  overlap = LabelOverlap{};
+  if (predicted.size() != ground_truth.size()) {
+    PCL_ERROR("[pcl::selective_seg::metrics::buildLabelOverlap] predicted labels "
+              "(%zu) != ground-truth labels (%zu)\n",
+              predicted.size(),
+              ground_truth.size());
+    return false;
+  }
+  collectLabels(predicted, ground_truth, overlap);
+  overlap.gt_sizes.assign(overlap.gt_labels.size(), 0);
+  overlap.predicted_sizes.assign(overlap.predicted_labels.size(), 0);
+  std::vector<std::uint64_t> keys;
+  keys.reserve(ground_truth.size());
+  for (std::size_t i = 0; i < ground_truth.size(); ++i) {
+    if (ground_truth[i] == 0)
+      continue;
+    ++overlap.num_valid_points;
+    const std::size_t n = indexOf(overlap.gt_labels, ground_truth[i]);
+    ++overlap.gt_sizes[n];
+    if (predicted[i] == 0) {
+      ++overlap.num_unlabeled_points;
+      continue;
+    }
+    const std::size_t m = indexOf(overlap.predicted_labels, predicted[i]);
+    ++overlap.predicted_sizes[m];
+    keys.push_back(static_cast<std::uint64_t>(n) << 32 | static_cast<std::uint64_t>(m));
+  }
+  overlap.entries = entriesFromKeys(keys);
+  return true;
+}
+
+HooverScores
+hooverScores(const LabelOverlap& overlap, double tolerance)
+{
+  HooverScores scores;
+  scores.tolerance = tolerance;
+  scores.num_gt_regions = overlap.gt_labels.size();
+  scores.num_predicted_regions = overlap.predicted_labels.size();
+  const std::vector<char> over = groupInstances(overlap, tolerance, true);
+  const std::vector<char> under = groupInstances(overlap, tolerance, false);
+  std::vector<char> gt_used(scores.num_gt_regions, 0);
+  std::vector<char> predicted_used(scores.num_predicted_regions, 0);
+  for (const auto& e : overlap.entries) {
+    const bool of_predicted =
+        atLeast(e.count, tolerance, overlap.predicted_sizes[e.predicted]);
+    const bool of_gt = atLeast(e.count, tolerance, overlap.gt_sizes[e.gt]);
+    if (of_predicted && of_gt)
+      ++scores.correct_detections;
+    if ((of_predicted && of_gt) || (of_predicted && over[e.gt]) ||
+        (of_gt && under[e.predicted])) {
+      gt_used[e.gt] = 1;
+      predicted_used[e.predicted] = 1;
+    }
+  }
+  scores.over_segmentations =
+      static_cast<std::size_t>(std::count(over.begin(), over.end(), 1));
+  scores.under_segmentations =
+      static_cast<std::size_t>(std::count(under.begin(), under.end(), 1));
+  scores.missed =
+      static_cast<std::size_t>(std::count(gt_used.begin(), gt_used.end(), 0));
+  scores.noise = static_cast<std::size_t>(
+      std::count(predicted_used.begin(), predicted_used.end(), 0));
+  return scores;
+}
+
+bool
+hooverMetrics(const std::vector<std::uint32_t>& predicted,
+              const std::vector<std::uint32_t>& ground_truth,
+              double tolerance,
+              HooverScores& scores)
+{
+  scores = HooverScores{};
+  if (!validTolerance(tolerance)) {
+    PCL_ERROR("[pcl::selective_seg::metrics::hooverMetrics] tolerance %g is not in "
+              "[0.5, 1]\n",
+              tolerance);
+    return false;
+  }
+  LabelOverlap overlap;
+  if (!buildLabelOverlap(predicted, ground_truth, overlap))
+    return false;
+  scores = hooverScores(overlap, tolerance);
+  return true;
+}
+
+bool
+hooverSweep(const std::vector<std::uint32_t>& predicted,
+            const std::vector<std::uint32_t>& ground_truth,
+            std::vector<HooverScores>& sweep,
+            double min_tolerance,
+            double max_tolerance,
+            double step)
+{
+  sweep.clear();
+  if (!validTolerance(min_tolerance) || !validTolerance(max_tolerance) ||
+      max_tolerance < min_tolerance || !(step > 0.0)) {
+    PCL_ERROR("[pcl::selective_seg::metrics::hooverSweep] bad range %g..%g step %g "
+              "(need 0.5 <= min <= max <= 1, step > 0)\n",
+              min_tolerance,
+              max_tolerance,
+              step);
+    return false;
+  }
+  LabelOverlap overlap;
+  if (!buildLabelOverlap(predicted, ground_truth, overlap))
+    return false;
+  for (std::size_t i = 0;; ++i) {
+    const double tolerance = min_tolerance + static_cast<double>(i) * step;
+    if (tolerance > max_tolerance + 1e-3 * step)
+      break;
+    sweep.push_back(hooverScores(overlap, std::min(tolerance, max_tolerance)));
+  }
+  return true;
+}
+
+std::vector<MajorityLabel>
+majorityLabels(const LabelOverlap& overlap)
+{
+  std::vector<MajorityLabel> majority(overlap.predicted_labels.size());
+  for (const auto& e : overlap.entries) {
+    auto& best = majority[e.predicted];
+    if (e.count > best.count) {
+      best.gt = e.gt;
+      best.count = e.count;
+    }
+  }
+  for (std::size_t m = 0; m < majority.size(); ++m)
+    majority[m].purity = ratio(majority[m].count, overlap.predicted_sizes[m]);
+  return majority;
+}
+
+UnderSegmentationError
+underSegmentationError(const LabelOverlap& overlap)
+{
+  const std::vector<MajorityLabel> majority = majorityLabels(overlap);
+  UnderSegmentationError result;
+  result.valid_points = overlap.num_valid_points;
+  for (const auto& e : overlap.entries)
+    if (e.gt != majority[e.predicted].gt)
+      result.leaked_points += e.count;
+  result.error = ratio(result.leaked_points, result.valid_points);
+  return result;
+}
+
+SegmentCoverage
+segmentsCovering(const LabelOverlap& overlap, double fraction)
+{
+  const auto& sizes = overlap.predicted_sizes;
+  std::vector<std::size_t> order(sizes.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::stable_sort(order.begin(), order.end(), [&sizes](std::size_t a, std::size_t b) {
+    return sizes[a] > sizes[b];
+  });
+  SegmentCoverage result;
+  result.fraction = fraction;
+  const std::size_t total = overlap.num_valid_points;
+  std::size_t covered = 0;
+  while (!atLeast(covered, fraction, total) && result.segments < order.size())
+    covered += sizes[order[result.segments++]];
+  result.reached = atLeast(covered, fraction, total);
+  result.covered_fraction = ratio(covered, total);
+  return result;
+}
+
+PartRecovery
+recoverableParts(const LabelOverlap& overlap,
+                 double min_purity,
+                 double min_part_fraction)
+{
+  const std::vector<MajorityLabel> majority = majorityLabels(overlap);
+  std::vector<std::size_t> recovered(overlap.gt_labels.size(), 0);
+  for (std::size_t m = 0; m < majority.size(); ++m)
+    if (atLeast(majority[m].count, min_purity, overlap.predicted_sizes[m]))
+      recovered[majority[m].gt] += majority[m].count;
+  PartRecovery result;
+  result.num_parts = overlap.gt_labels.size();
+  for (std::size_t n = 0; n < result.num_parts; ++n)
+    if (atLeast(recovered[n], min_part_fraction, overlap.gt_sizes[n]))
+      ++result.recoverable_parts;
+  result.fraction = ratio(result.recoverable_parts, result.num_parts);
+  return result;
+}
+
+namespace {
+
+/** The GT-valid points with finite coordinates, and their input indices. */
+pcl::PointCloud<pcl::PointXYZ>::Ptr
+validPoints(const pcl::PointCloud<pcl::PointXYZ>& cloud,
+            const std::vector<std::uint32_t>& ground_truth,
+            std::vector<std::size_t>& input_index)
+{
+  auto valid = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  input_index.clear();
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    if (ground_truth[i] != 0 && pcl::isFinite(cloud[i])) {
+      valid->push_back(cloud[i]);
+      input_index.push_back(i);
+    }
+  }
+  return valid;
+}
+
+/** Flags the GT and predicted boundary points among the valid points. */
+void
+findBoundaries(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& valid,
+               const std::vector<std::uint32_t>& predicted,
+               const std::vector<std::uint32_t>& ground_truth,
+               double radius,
+               std::vector<char>& gt_boundary,
+               std::vector<char>& predicted_boundary)
+{
+  gt_boundary.assign(valid->size(), 0);
+  predicted_boundary.assign(valid->size(), 0);
+  if (valid->empty())
+    return;
+  pcl::search::KdTree<pcl::PointXYZ> tree(false);
+  tree.setInputCloud(valid);
+  pcl::Indices neighbours;
+  std::vector<float> sqr_distances;
+  for (std::size_t k = 0; k < valid->size(); ++k) {
+    tree.radiusSearch(static_cast<pcl::index_t>(k), radius, neighbours, sqr_distances);
+    for (const auto j : neighbours) {
+      const auto jj = static_cast<std::size_t>(j);
+      if (ground_truth[jj] != ground_truth[k])
+        gt_boundary[k] = 1;
+      if (predicted[k] != 0 && predicted[jj] != predicted[k])
+        predicted_boundary[k] = 1;
+    }
+  }
+}
+
+/** Labels of the valid points, in the order of validPoints(). */
+std::vector<std::uint32_t>
+gather(const std::vector<std::uint32_t>& labels, const std::vector<std::size_t>& index)
+{
+  std::vector<std::uint32_t> out(index.size());
+  for (std::size_t k = 0; k < index.size(); ++k)
+    out[k] = labels[index[k]];
+  return out;
+}
+
+/** Number of GT boundary points within match_distance of a predicted one. */
+std::size_t
+matchBoundaries(const pcl::PointCloud<pcl::PointXYZ>& valid,
+                const std::vector<char>& gt_boundary,
+                const std::vector<char>& predicted_boundary,
+                double match_distance)
+{
+  auto targets = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  for (std::size_t k = 0; k < valid.size(); ++k)
+    if (predicted_boundary[k])
+      targets->push_back(valid[k]);
+  if (targets->empty())
+    return 0;
+  pcl::search::KdTree<pcl::PointXYZ> tree(false);
+  tree.setInputCloud(targets);
+  pcl::Indices nearest;
+  std::vector<float> sqr_distances;
+  std::size_t matched = 0;
+  for (std::size_t k = 0; k < valid.size(); ++k) {
+    if (!gt_boundary[k] || tree.nearestKSearch(valid[k], 1, nearest, sqr_distances) < 1)
+      continue;
+    if (std::sqrt(static_cast<double>(sqr_distances[0])) <= match_distance)
+      ++matched;
+  }
+  return matched;
+}
+
+} // namespace
+
+bool
+boundaryRecall(const pcl::PointCloud<pcl::PointXYZ>& cloud,
+               const std::vector<std::uint32_t>& predicted,
+               const std::vector<std::uint32_t>& ground_truth,
+               double radius,
+               double match_distance,
+               BoundaryRecall& result)
+{
+  result = BoundaryRecall{};
+  if (predicted.size() != cloud.size() || ground_truth.size() != cloud.size()) {
+    PCL_ERROR("[pcl::selective_seg::metrics::boundaryRecall] points (%zu), predicted "
+              "labels (%zu) and ground-truth labels (%zu) differ\n",
+              static_cast<std::size_t>(cloud.size()),
+              predicted.size(),
+              ground_truth.size());
+    return false;
+  }
+  if (!(radius > 0.0) || !std::isfinite(radius) || !(match_distance >= 0.0) ||
+      !std::isfinite(match_distance)) {
+    PCL_ERROR("[pcl::selective_seg::metrics::boundaryRecall] radius %g must be > 0 "
+              "and match distance %g >= 0 [m]\n",
+              radius,
+              match_distance);
+    return false;
+  }
+  std::vector<std::size_t> input_index;
+  const auto valid = validPoints(cloud, ground_truth, input_index);
+  std::vector<char> gt_boundary;
+  std::vector<char> predicted_boundary;
+  findBoundaries(valid,
+                 gather(predicted, input_index),
+                 gather(ground_truth, input_index),
+                 radius,
+                 gt_boundary,
+                 predicted_boundary);
+  result.gt_boundary_points =
+      static_cast<std::size_t>(std::count(gt_boundary.begin(), gt_boundary.end(), 1));
+  result.predicted_boundary_points = static_cast<std::size_t>(
+      std::count(predicted_boundary.begin(), predicted_boundary.end(), 1));
+  result.matched_points =
+      matchBoundaries(*valid, gt_boundary, predicted_boundary, match_distance);
+  result.recall = ratio(result.matched_points, result.gt_boundary_points);
+  return true;
+}
+
+bool
+objectMetrics(const pcl::PointCloud<pcl::PointXYZ>& cloud,
+              const std::vector<std::uint32_t>& predicted,
+              const std::vector<std::uint32_t>& ground_truth,
+              const ObjectMetricsParams& params,
+              ObjectScores& scores)
+{
+  scores = ObjectScores{};
+  if (!inUnitInterval(params.coverage_fraction) || !inUnitInterval(params.min_purity) ||
+      !inUnitInterval(params.min_part_fraction)) {
+    PCL_ERROR("[pcl::selective_seg::metrics::objectMetrics] coverage fraction %g, "
+              "min purity %g and min part fraction %g must be in (0, 1]\n",
+              params.coverage_fraction,
+              params.min_purity,
+              params.min_part_fraction);
+    return false;
+  }
+  LabelOverlap overlap;
+  BoundaryRecall boundary;
+  if (!boundaryRecall(cloud,
+                      predicted,
+                      ground_truth,
+                      params.boundary_radius,
+                      params.boundary_match_distance,
+                      boundary) ||
+      !buildLabelOverlap(predicted, ground_truth, overlap))
+    return false;
+  scores.num_gt_regions = overlap.gt_labels.size();
+  scores.num_predicted_regions = overlap.predicted_labels.size();
+  scores.unlabeled_fraction =
+      ratio(overlap.num_unlabeled_points, overlap.num_valid_points);
+  scores.under_segmentation = underSegmentationError(overlap);
+  scores.boundary = boundary;
+  scores.coverage = segmentsCovering(overlap, params.coverage_fraction);
+  scores.parts = recoverableParts(overlap, params.min_purity, params.min_part_fraction);
+  return true;
+}
+
+} // namespace metrics
+} // namespace selective_seg
+} // namespace pcl
