@@ -1,0 +1,316 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
+ */
+
+// pcl_selective_seg_compare: run this project's segmentation and PCL's segmenters on
+// the same ground-truth clouds, measure quality and run time, and print a markdown
+// table.
+//
+// Inputs are PCD files with x y z and a ground-truth "label" field (0 = invalid), with
+// the sensor at the origin looking along +z (the simulator's output, the mOSD frames).
+// Exit codes: 0 = success, 1 = runtime error, 2 = usage error.
+
+#include <pcl_selective_seg/segmentation_metrics.h>
+#include <pcl_selective_seg/selective_segmentation.h>
+
+#include <pcl/common/point_tests.h>
+#include <pcl/common/time.h>
+#include <pcl/console/parse.h>
+#include <pcl/console/print.h>
+#include <pcl/features/integral_image_normal.h>
+#include <pcl/features/normal_3d.h>
+#include <pcl/io/pcd_io.h>
+#include <pcl/search/kdtree.h>
+#include <pcl/segmentation/lccp_segmentation.h>
+#include <pcl/segmentation/organized_multi_plane_segmentation.h>
+#include <pcl/segmentation/region_growing.h>
+#include <pcl/segmentation/supervoxel_clustering.h>
+
+#include <cstdio>
+#include <fstream>
+#include <functional>
+#include <string>
+#include <vector>
+
+using namespace pcl::console;
+using Cloud = pcl::PointCloud<pcl::PointXYZ>;
+using Labels = std::vector<std::uint32_t>;
+
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+/** A method's labels (one per input point, 0 = none) and its run time. */
+struct Run {
+  Labels labels;
+  double seconds = 0.0;
+  bool ok = false;
+};
+
+struct Method {
+  std::string name;
+  std::function<Run(const Cloud::ConstPtr&)> run;
+  bool organized_only = false;
+};
+
+Labels
+fromClusters(std::size_t n, const std::vector<pcl::PointIndices>& clusters)
+{
+  Labels labels(n, 0);
+  for (std::size_t c = 0; c < clusters.size(); ++c)
+    for (const auto i : clusters[c].indices)
+      labels[i] = static_cast<std::uint32_t>(c + 1);
+  return labels;
+}
+
+Run
+runSelective(const Cloud::ConstPtr& cloud,
+             const pcl::selective_seg::SelectiveSegmentationParameters& params)
+{
+  Run r;
+  pcl::StopWatch watch;
+  pcl::selective_seg::SelectiveSegmentation<pcl::PointXYZ> seg;
+  seg.setParameters(params);
+  seg.setSensorPose(Eigen::Affine3f::Identity());
+  seg.setInputCloud(cloud);
+  std::vector<pcl::PointIndices> clusters;
+  r.ok = seg.extract(clusters);
+  r.seconds = watch.getTimeSeconds();
+  r.labels = r.ok ? seg.getResult().labels : Labels(cloud->size(), 0);
+  return r;
+}
+
+/** pcl::NormalEstimation (30 neighbours) + pcl::RegionGrowing (30 neighbours, 5 deg
+ * smoothness, curvature 1.0, at least 50 points), the PCL tutorial's setup. */
+Run
+runRegionGrowing(const Cloud::ConstPtr& cloud)
+{
+  Run r;
+  pcl::StopWatch watch;
+  auto valid = pcl::make_shared<pcl::Indices>();
+  for (pcl::index_t i = 0; i < static_cast<pcl::index_t>(cloud->size()); ++i)
+    if (pcl::isFinite((*cloud)[i]))
+      valid->push_back(i);
+  auto tree = pcl::make_shared<pcl::search::KdTree<pcl::PointXYZ>>();
+  auto normals = pcl::make_shared<pcl::PointCloud<pcl::Normal>>();
+  pcl::NormalEstimation<pcl::PointXYZ, pcl::Normal> ne;
+  ne.setSearchMethod(tree);
+  ne.setInputCloud(cloud);
+  ne.setIndices(valid);
+  ne.setKSearch(30);
+  ne.compute(*normals);
+  // NormalEstimation with indices returns one normal per index: spread them back.
+  auto full =
+      pcl::make_shared<pcl::PointCloud<pcl::Normal>>(cloud->width, cloud->height);
+  for (std::size_t k = 0; k < valid->size(); ++k)
+    (*full)[(*valid)[k]] = (*normals)[k];
+  pcl::RegionGrowing<pcl::PointXYZ, pcl::Normal> rg;
+  rg.setMinClusterSize(50);
+  rg.setSearchMethod(tree);
+  rg.setNumberOfNeighbours(30);
+  rg.setInputCloud(cloud);
+  rg.setIndices(valid);
+  rg.setInputNormals(full);
+  rg.setSmoothnessThreshold(5.0 * kDeg);
+  rg.setCurvatureThreshold(1.0);
+  std::vector<pcl::PointIndices> clusters;
+  rg.extract(clusters);
+  r.seconds = watch.getTimeSeconds();
+  r.labels = fromClusters(cloud->size(), clusters);
+  r.ok = true;
+  return r;
+}
+
+/** pcl::SupervoxelClustering (voxel 1 cm, seed 4 cm, spatial 1, normal 4, no colour)
+ * + pcl::LCCPSegmentation (concavity 10 deg, smoothness and sanity checks), as in
+ * PCL's LCCP example. */
+Run
+runLccp(const Cloud::ConstPtr& cloud)
+{
+  Run r;
+  pcl::StopWatch watch;
+  const float voxel = 0.01f, seed = 0.04f;
+  pcl::SupervoxelClustering<pcl::PointXYZ> super(voxel, seed);
+  super.setUseSingleCameraTransform(false);
+  super.setInputCloud(cloud);
+  super.setColorImportance(0.0f);
+  super.setSpatialImportance(1.0f);
+  super.setNormalImportance(4.0f);
+  std::map<std::uint32_t, pcl::Supervoxel<pcl::PointXYZ>::Ptr> supervoxels;
+  super.extract(supervoxels);
+  std::multimap<std::uint32_t, std::uint32_t> adjacency;
+  super.getSupervoxelAdjacency(adjacency);
+  pcl::LCCPSegmentation<pcl::PointXYZ> lccp;
+  lccp.setConcavityToleranceThreshold(10.0f);
+  lccp.setSanityCheck(true);
+  lccp.setSmoothnessCheck(true, voxel, seed, 0.1f);
+  lccp.setKFactor(0);
+  lccp.setInputSupervoxels(supervoxels, adjacency);
+  lccp.setMinSegmentSize(0);
+  lccp.segment();
+  auto labeled = super.getLabeledCloud();
+  lccp.relabelCloud(*labeled);
+  r.seconds = watch.getTimeSeconds();
+  r.labels.resize(cloud->size());
+  for (std::size_t i = 0; i < cloud->size(); ++i)
+    r.labels[i] = (*labeled)[i].label;
+  r.ok = true;
+  return r;
+}
+
+/** pcl::IntegralImageNormalEstimation (covariance, depth change 0.02, smoothing 10) +
+ * pcl::OrganizedMultiPlaneSegmentation (1000 inliers, 3 deg, 2 cm), refined. */
+Run
+runMultiPlane(const Cloud::ConstPtr& cloud)
+{
+  Run r;
+  pcl::StopWatch watch;
+  auto normals = pcl::make_shared<pcl::PointCloud<pcl::Normal>>();
+  pcl::IntegralImageNormalEstimation<pcl::PointXYZ, pcl::Normal> ne;
+  ne.setNormalEstimationMethod(ne.COVARIANCE_MATRIX);
+  ne.setMaxDepthChangeFactor(0.02f);
+  ne.setNormalSmoothingSize(10.0f);
+  ne.setInputCloud(cloud);
+  ne.compute(*normals);
+  pcl::OrganizedMultiPlaneSegmentation<pcl::PointXYZ, pcl::Normal, pcl::Label> mps;
+  mps.setMinInliers(1000);
+  mps.setAngularThreshold(3.0 * kDeg);
+  mps.setDistanceThreshold(0.02);
+  mps.setInputNormals(normals);
+  mps.setInputCloud(cloud);
+  std::vector<pcl::PlanarRegion<pcl::PointXYZ>,
+              Eigen::aligned_allocator<pcl::PlanarRegion<pcl::PointXYZ>>>
+      regions;
+  std::vector<pcl::ModelCoefficients> coefficients;
+  std::vector<pcl::PointIndices> inliers, label_indices, boundaries;
+  auto plane_labels = pcl::make_shared<pcl::PointCloud<pcl::Label>>();
+  mps.segmentAndRefine(
+      regions, coefficients, inliers, plane_labels, label_indices, boundaries);
+  r.seconds = watch.getTimeSeconds();
+  r.labels = fromClusters(cloud->size(), inliers);
+  r.ok = true;
+  return r;
+}
+
+std::vector<Method>
+methods()
+{
+  using pcl::selective_seg::SelectiveSegmentationParameters;
+  SelectiveSegmentationParameters paper;
+  paper.max_view_incidence_angle = 90.0 * kDeg; // the literal paper
+  const SelectiveSegmentationParameters defaults;
+  SelectiveSegmentationParameters rings = defaults;
+  rings.normal_rings = 3;
+  return {{"selective (paper)",
+           [paper](const Cloud::ConstPtr& c) { return runSelective(c, paper); }},
+          {"selective (default)",
+           [defaults](const Cloud::ConstPtr& c) { return runSelective(c, defaults); }},
+          {"selective (rings 3)",
+           [rings](const Cloud::ConstPtr& c) { return runSelective(c, rings); }},
+          {"RegionGrowing", runRegionGrowing},
+          {"Supervoxel+LCCP", runLccp},
+          {"OrganizedMultiPlane", runMultiPlane, true}};
+}
+
+std::string
+row(const std::string& scene,
+    const std::string& method,
+    const Cloud& cloud,
+    const Labels& truth,
+    const Run& run)
+{
+  namespace m = pcl::selective_seg::metrics;
+  if (!run.ok)
+    return "| " + scene + " | " + method + " | failed |||||||||||\n";
+  m::HooverScores h;
+  m::hooverMetrics(run.labels, truth, 0.8, h);
+  m::ObjectScores o;
+  m::ObjectMetricsParams params;
+  params.boundary_radius = params.boundary_match_distance = 0.02;
+  m::objectMetrics(cloud, run.labels, truth, params, o);
+  char line[512];
+  std::snprintf(
+      line,
+      sizeof(line),
+      "| %s | %s | %.3f | %zu | %zu | %zu | %zu | %zu | %zu | %.2f%% | %.2f | "
+      "%zu | %.2f |\n",
+      scene.c_str(),
+      method.c_str(),
+      run.seconds,
+      h.num_predicted_regions,
+      h.correct_detections,
+      h.over_segmentations,
+      h.under_segmentations,
+      h.missed,
+      h.noise,
+      100.0 * o.under_segmentation.error,
+      o.boundary.recall,
+      o.coverage.segments,
+      o.parts.fraction);
+  return line;
+}
+
+const char* kHeader =
+    "| scene | method | time (s) | segments | correct | over | under | missed | noise "
+    "| under-seg. error | boundary recall | segments for 90% | recoverable parts |\n"
+    "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+
+bool
+evaluate(const std::string& path, std::string& table)
+{
+  pcl::PointCloud<pcl::PointXYZL> labeled;
+  if (pcl::io::loadPCDFile(path, labeled) != 0 || labeled.empty()) {
+    print_error("Cannot read '%s' as a PCD with x y z label fields.\n", path.c_str());
+    return false;
+  }
+  auto cloud = pcl::make_shared<Cloud>();
+  pcl::copyPointCloud(labeled, *cloud);
+  Labels truth(labeled.size());
+  for (std::size_t i = 0; i < labeled.size(); ++i)
+    truth[i] = std::isfinite(labeled[i].z) ? labeled[i].label : 0;
+  const std::string scene = path.substr(path.find_last_of('/') + 1);
+  for (const auto& method : methods()) {
+    if (method.organized_only && !cloud->isOrganized())
+      continue;
+    const std::string line = row(scene, method.name, *cloud, truth, method.run(cloud));
+    std::fputs(line.c_str(), stdout);
+    std::fflush(stdout);
+    table += line;
+  }
+  return true;
+}
+
+} // namespace
+
+int
+main(int argc, char** argv)
+{
+  if (argc < 2 || find_switch(argc, argv, "-h") || find_switch(argc, argv, "--help")) {
+    print_info("Compare segmenters on ground-truth clouds.\n\n"
+               "Usage: %s CLOUD.pcd [CLOUD.pcd ...] [-o TABLE.md]\n"
+               "  CLOUD.pcd  x y z label (ground truth; 0 = invalid), sensor at the "
+               "origin looking along +z\n"
+               "  -o FILE    also write the markdown table to FILE\n",
+               argv[0]);
+    return argc < 2 ? 2 : 0;
+  }
+  std::string output;
+  parse_argument(argc, argv, "-o", output);
+  std::string table = kHeader;
+  std::fputs(kHeader, stdout);
+  for (const int i : parse_file_extension_argument(argc, argv, ".pcd"))
+    if (argv[i] != output && !evaluate(argv[i], table))
+      return 1;
+  if (!output.empty()) {
+    const std::string tmp = output + ".tmp";
+    std::ofstream(tmp) << table;
+    if (std::rename(tmp.c_str(), output.c_str()) != 0) {
+      std::remove(tmp.c_str());
+      print_error("Cannot write '%s'.\n", output.c_str());
+      return 1;
+    }
+  }
+  return 0;
+}

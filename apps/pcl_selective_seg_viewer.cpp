@@ -1,0 +1,801 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
+ */
+
+// pcl_selective_seg_viewer: segment a scan and show the result as the paper's figures
+// do: the mesh coloured by segment with white edge triangles (Figs. 7-9) and the
+// labeled multi-resolution octree (Figs. 10-12), seen from the sensor. The raw points
+// and the point normals are further layers; keys toggle each of them. With
+// -screenshot the picture is rendered off screen and saved instead.
+//
+// Exit codes: 0 = success, 1 = runtime error (unreadable input, segmentation failure,
+// no X display, unwritable screenshot), 2 = usage error (bad option).
+
+#include <pcl_selective_seg/selective_segmentation.h>
+
+#include <pcl/console/parse.h>
+#include <pcl/console/print.h>
+#include <pcl/console/time.h>
+#include <pcl/visualization/pcl_visualizer.h>
+#include <vtkActor.h>
+#include <vtkCamera.h>
+#include <vtkCellArray.h>
+#include <vtkCellData.h>
+#include <vtkNew.h>
+#include <vtkPNGWriter.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkPolyDataMapper.h>
+#include <vtkProperty.h>
+#include <vtkRenderWindow.h>
+#include <vtkRenderer.h>
+#include <vtkRendererCollection.h>
+#include <vtkRenderingOpenGLConfigure.h>
+#include <vtkSmartPointer.h>
+#include <vtkUnsignedCharArray.h>
+#include <vtkWindowToImageFilter.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "scan_io.h"
+#include "segment_colors.h"
+
+using namespace pcl::console;
+using pcl::selective_seg::SegmentationResult;
+using pcl::selective_seg::SelectiveSegmentationParameters;
+
+namespace {
+
+constexpr int kRuntimeError = 1;
+constexpr int kUsageError = 2;
+constexpr double kDeg = M_PI / 180.0;
+
+using Cloud = pcl::PointCloud<pcl::PointXYZ>;
+using NormalCloud = pcl::PointCloud<pcl::Normal>;
+using PolyData = vtkSmartPointer<vtkPolyData>;
+
+/** The layers of the picture, in the order of the key legend. */
+enum Layer { kMesh = 0, kOctree, kCloud, kNormals, kNumLayers };
+
+/** Key, name and description of each layer (keys PCLVisualizer and VTK leave free). */
+struct LayerInfo {
+  char key;
+  const char* name;
+  const char* description;
+};
+constexpr std::array<LayerInfo, kNumLayers> kLayers = {
+    {{'t', "mesh", "mesh triangles by segment, edge triangles white"},
+     {'v', "octree", "octree leaves by segment"},
+     {'d', "cloud", "data points by segment"},
+     {'n', "normals", "point normals (subsampled)"}}};
+
+/** Every option of the tool, with its default. */
+struct Options {
+  std::string input;
+  double unit_scale = 1.0;
+  bool ignore_viewpoint = false;
+  SelectiveSegmentationParameters params;
+  std::array<bool, kNumLayers> view = {true, false, false, false}; ///< shown at start
+  std::string screenshot;
+  int width = 1280;
+  int height = 960;
+  int normal_step = 0; ///< 0 = about 5000 normals
+  bool octree_wireframe = false;
+  bool legend = true;
+};
+
+/** The segmented scan: what the layers are built from. */
+struct Scene {
+  Cloud::Ptr cloud;
+  Eigen::Affine3f sensor_pose = Eigen::Affine3f::Identity(); ///< sensor to cloud
+  SegmentationResult result;
+  NormalCloud::ConstPtr normals;
+};
+
+void
+printHelp(const char* program)
+{
+  const Options d;
+  const SelectiveSegmentationParameters p;
+  print_info(
+      "Segment a 3-D scan seen from one sensor and show the segments, as the\n"
+      "mesh (edge triangles white) and as the labeled octree, from the sensor.\n\n"
+      "Usage: %s input.{pcd,ply,xyz,txt} [options]\n\n",
+      program);
+  print_info("Input:\n");
+  print_info("  -unit_scale X          factor applied to the coordinates, e.g. 0.001 "
+             "for millimetres [-] (default %g)\n",
+             d.unit_scale);
+  print_info("  -ignore_viewpoint      sensor at the origin looking along +z, whatever "
+             "the file's VIEWPOINT says (default off)\n");
+  print_info("Segmentation (defaults are the paper's where it gives one):\n");
+  print_info("  -split_deg X           octree split threshold on the normals' std dev "
+             "[deg] (default %.1f)\n",
+             p.max_normal_std_dev / kDeg);
+  print_info("  -merge_deg X           max angle between merged segment normals [deg] "
+             "(default %.1f)\n",
+             p.max_merge_angle / kDeg);
+  print_info("  -edge_deg X            max angle of a valid edge triangle [deg] "
+             "(default %.1f)\n",
+             p.max_edge_triangle_angle / kDeg);
+  print_info("  -incidence_deg X       max view incidence of a valid edge triangle "
+             "[deg]; 90 = off (default %.1f)\n",
+             p.max_view_incidence_angle / kDeg);
+  print_info("  -min_voxel_m X         smallest octree voxel [m]; 0 = %.1f x median "
+             "point spacing (default %g)\n",
+             p.min_voxel_size_factor,
+             p.min_voxel_size);
+  print_info(
+      "  -normal_rings N        point normals over the N-ring of mesh triangles; "
+      "1 = the paper [rings] (default %d)\n",
+      p.normal_rings);
+  print_info("Display:\n");
+  print_info("  -view LAYER[,LAYER]    layers shown at start: mesh, octree, cloud, "
+             "normals (default mesh)\n");
+  print_info("  -wireframe             octree leaves as outlines, not solid cubes "
+             "(default solid)\n");
+  print_info("  -normal_step N         draw the normal of every N-th labeled point; "
+             "0 = about 5000 normals [points] (default %d)\n",
+             d.normal_step);
+  print_info("  -no_legend             hide the key legend (default shown)\n");
+  print_info("  -screenshot FILE.png   render off screen, save the picture, exit\n");
+  print_info("  -size WxH              window or picture size [pixels] (default "
+             "%dx%d)\n",
+             d.width,
+             d.height);
+  print_info("  -h, --help             this help\n\n");
+  print_info("Keys: t mesh, v octree, d data points, n normals, b solid/outline "
+             "cubes,\n      z back to the sensor's view, i legend; q quits.\n");
+}
+
+/** A checked numeric option: absent is fine, present and unparsable is a usage error.
+ */
+template <typename T>
+bool
+parseChecked(int argc, char** argv, const char* flag, T& value)
+{
+  if (find_argument(argc, argv, flag) < 0)
+    return true;
+  if (parse_argument(argc, argv, flag, value) < 0 || !std::isfinite(double(value))) {
+    print_error("Option %s needs a number (see -h).\n", flag);
+    return false;
+  }
+  return true;
+}
+
+bool
+parseDegrees(int argc, char** argv, const char* flag, double& radians)
+{
+  double degrees = radians / kDeg;
+  if (!parseChecked(argc, argv, flag, degrees))
+    return false;
+  radians = degrees * kDeg;
+  return true;
+}
+
+/** "-size WxH": two integers in [64, 8192]. */
+bool
+parseSize(int argc, char** argv, Options& opt)
+{
+  std::string text;
+  if (parse_argument(argc, argv, "-size", text) < 0)
+    return true;
+  int w = 0, h = 0;
+  char tail = 0;
+  if (std::sscanf(text.c_str(), "%dx%d%c", &w, &h, &tail) != 2 || w < 64 || h < 64 ||
+      w > 8192 || h > 8192) {
+    print_error("Option -size needs WIDTHxHEIGHT in pixels, each 64 to 8192, e.g. "
+                "1280x960.\n");
+    return false;
+  }
+  opt.width = w;
+  opt.height = h;
+  return true;
+}
+
+/** "-view LAYER[,LAYER...]" with the layers mesh, octree, cloud and normals. */
+bool
+parseView(int argc, char** argv, Options& opt)
+{
+  std::string list;
+  if (parse_argument(argc, argv, "-view", list) < 0)
+    return true;
+  opt.view.fill(false);
+  std::size_t begin = 0;
+  while (begin <= list.size()) {
+    const std::size_t end = std::min(list.find(',', begin), list.size());
+    const std::string name = list.substr(begin, end - begin);
+    const auto info = std::find_if(
+        kLayers.begin(), kLayers.end(), [&name](auto& l) { return name == l.name; });
+    if (info == kLayers.end()) {
+      print_error("Unknown layer '%s' in -view: use mesh, octree, cloud or normals, "
+                  "comma-separated.\n",
+                  name.c_str());
+      return false;
+    }
+    opt.view[info - kLayers.begin()] = true;
+    begin = end + 1;
+  }
+  return true;
+}
+
+bool
+isValueFlag(const std::string& arg)
+{
+  static const std::vector<std::string> flags = {"-unit_scale",
+                                                 "-split_deg",
+                                                 "-merge_deg",
+                                                 "-edge_deg",
+                                                 "-incidence_deg",
+                                                 "-min_voxel_m",
+                                                 "-normal_rings",
+                                                 "-view",
+                                                 "-normal_step",
+                                                 "-screenshot",
+                                                 "-size"};
+  return std::find(flags.begin(), flags.end(), arg) != flags.end();
+}
+
+bool
+isSwitch(const std::string& arg)
+{
+  return arg == "-ignore_viewpoint" || arg == "-wireframe" || arg == "-no_legend" ||
+         arg == "-h" || arg == "--help";
+}
+
+/** The one input file; every other argument must be a known option. */
+bool
+parseInput(int argc, char** argv, Options& opt)
+{
+  std::vector<std::string> files;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (isValueFlag(arg)) {
+      if (++i == argc) {
+        print_error("Option %s needs a value (see -h).\n", arg.c_str());
+        return false;
+      }
+    } else if (!arg.empty() && arg[0] == '-' && !isSwitch(arg)) {
+      print_error("Unknown option '%s' (see -h).\n", arg.c_str());
+      return false;
+    } else if (!isSwitch(arg))
+      files.push_back(arg);
+  }
+  if (files.size() != 1) {
+    print_error("Give exactly one input file, .pcd, .ply or .xyz (see -h).\n");
+    return false;
+  }
+  opt.input = files[0];
+  return true;
+}
+
+/** \return 0 on success, else the exit code. */
+int
+parseOptions(int argc, char** argv, Options& opt)
+{
+  if (!parseInput(argc, argv, opt))
+    return kUsageError;
+  auto& p = opt.params;
+  if (!parseChecked(argc, argv, "-unit_scale", opt.unit_scale) ||
+      !parseDegrees(argc, argv, "-split_deg", p.max_normal_std_dev) ||
+      !parseDegrees(argc, argv, "-merge_deg", p.max_merge_angle) ||
+      !parseDegrees(argc, argv, "-edge_deg", p.max_edge_triangle_angle) ||
+      !parseDegrees(argc, argv, "-incidence_deg", p.max_view_incidence_angle) ||
+      !parseChecked(argc, argv, "-min_voxel_m", p.min_voxel_size) ||
+      !parseChecked(argc, argv, "-normal_rings", p.normal_rings) ||
+      !parseChecked(argc, argv, "-normal_step", opt.normal_step) ||
+      !parseSize(argc, argv, opt) || !parseView(argc, argv, opt))
+    return kUsageError;
+  if (opt.unit_scale <= 0.0) {
+    print_error("Option -unit_scale must be positive.\n");
+    return kUsageError;
+  }
+  if (opt.normal_step < 0) {
+    print_error("Option -normal_step must be 0 (automatic) or positive.\n");
+    return kUsageError;
+  }
+  std::string why;
+  if (!p.validate(&why)) {
+    print_error("%s\n", why.c_str());
+    return kUsageError;
+  }
+  parse_argument(argc, argv, "-screenshot", opt.screenshot);
+  opt.ignore_viewpoint = find_switch(argc, argv, "-ignore_viewpoint");
+  opt.octree_wireframe = find_switch(argc, argv, "-wireframe");
+  opt.legend = !find_switch(argc, argv, "-no_legend");
+  return 0;
+}
+
+/** Read the scan. \return false, with a message, on failure. */
+bool
+loadInput(const Options& opt, Scene& scene)
+{
+  TicToc timer;
+  timer.tic();
+  scene.cloud = pcl::make_shared<Cloud>();
+  std::string error;
+  if (!selseg_apps::loadScan(opt.input, opt.unit_scale, *scene.cloud, error)) {
+    print_error("%s\n", error.c_str());
+    return false;
+  }
+  if (!opt.ignore_viewpoint) {
+    scene.sensor_pose.translation() = scene.cloud->sensor_origin_.head<3>();
+    scene.sensor_pose.linear() =
+        scene.cloud->sensor_orientation_.normalized().toRotationMatrix();
+  }
+  print_info("Loaded '%s' [done, %g ms : %zu points]\n",
+             opt.input.c_str(),
+             timer.toc(),
+             scene.cloud->size());
+  return true;
+}
+
+/** Segment the scan. \return false, with a message, on failure. */
+bool
+segment(const Options& opt, Scene& scene)
+{
+  TicToc timer;
+  timer.tic();
+  pcl::selective_seg::SelectiveSegmentation<pcl::PointXYZ> seg;
+  seg.setParameters(opt.params);
+  seg.setSensorPose(scene.sensor_pose);
+  seg.setInputCloud(scene.cloud);
+  std::vector<pcl::PointIndices> segments;
+  if (!seg.extract(segments)) {
+    print_error("Segmentation failed (reason above); if every point lies behind the "
+                "file's VIEWPOINT, pass -ignore_viewpoint.\n");
+    return false;
+  }
+  scene.result = seg.getResult();
+  scene.normals = seg.getPointNormals();
+  print_info("Segmented [done, %g ms : %zu segments, %zu octree leaves, %zu "
+             "triangles]\n",
+             timer.toc(),
+             scene.result.segments.size(),
+             scene.result.leaves.size(),
+             scene.result.mesh.triangles.size());
+  return true;
+}
+
+/** VTK's X11 render windows abort without an X display: say what to do instead.
+ * \return false, with a message, when rendering cannot work. */
+bool
+checkDisplay()
+{
+#if defined(VTK_USE_X) && !defined(VTK_OPENGL_HAS_EGL) &&                              \
+    !defined(VTK_OPENGL_HAS_OSMESA)
+  const char* display = std::getenv("DISPLAY");
+  if (display == nullptr || *display == '\0') {
+    print_error("No X display (DISPLAY is not set): run it in a desktop session, or "
+                "for -screenshot under xvfb-run -a -s \"-screen 0 1280x1024x24\".\n");
+    return false;
+  }
+#endif
+  return true;
+}
+
+/** A 3-component colour array for cell or point scalars. */
+vtkSmartPointer<vtkUnsignedCharArray>
+newColors(vtkIdType count)
+{
+  auto colors = vtkSmartPointer<vtkUnsignedCharArray>::New();
+  colors->SetName("colors");
+  colors->SetNumberOfComponents(3);
+  colors->SetNumberOfTuples(count);
+  return colors;
+}
+
+/** The segmented mesh: one triangle cell per mesh triangle, coloured by
+ * selseg_apps::triangleColor (segment hue, edge triangles white). Only the points
+ * used by triangles become vertices, so that non-finite points never reach VTK. */
+PolyData
+buildMesh(const Scene& scene)
+{
+  const auto& mesh = scene.result.mesh;
+  std::vector<vtkIdType> vertex(scene.cloud->size(), -1);
+  auto points = vtkSmartPointer<vtkPoints>::New();
+  auto cells = vtkSmartPointer<vtkCellArray>::New();
+  auto colors = newColors(static_cast<vtkIdType>(mesh.triangles.size()));
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    std::array<vtkIdType, 3> ids;
+    for (int k = 0; k < 3; ++k) {
+      const auto i = mesh.triangles[t][k];
+      if (vertex[i] < 0)
+        vertex[i] = points->InsertNextPoint((*scene.cloud)[i].data);
+      ids[k] = vertex[i];
+    }
+    cells->InsertNextCell(3, ids.data());
+    const auto rgb = selseg_apps::triangleColor(mesh.labels[t], mesh.classes[t]);
+    colors->SetTypedTuple(static_cast<vtkIdType>(t), rgb.data());
+  }
+  auto data = PolyData::New();
+  data->SetPoints(points);
+  data->SetPolys(cells);
+  data->GetCellData()->SetScalars(colors);
+  return data;
+}
+
+/** The octree leaves as cubes (six quads each) coloured by segment. The voxels'
+ * axes are the sensor's axes, so every cube is rotated by the sensor orientation. */
+PolyData
+buildOctree(const Scene& scene)
+{
+  static constexpr int kFaces[6][4] = {{0, 2, 3, 1},
+                                       {4, 5, 7, 6},
+                                       {0, 1, 5, 4},
+                                       {2, 6, 7, 3},
+                                       {0, 4, 6, 2},
+                                       {1, 3, 7, 5}};
+  const Eigen::Matrix3f rotation = scene.sensor_pose.linear();
+  const auto& leaves = scene.result.leaves;
+  auto points = vtkSmartPointer<vtkPoints>::New();
+  points->SetNumberOfPoints(static_cast<vtkIdType>(8 * leaves.size()));
+  auto cells = vtkSmartPointer<vtkCellArray>::New();
+  auto colors = newColors(static_cast<vtkIdType>(6 * leaves.size()));
+  vtkIdType point_id = 0, cell_id = 0;
+  for (const auto& leaf : leaves) {
+    const float h = 0.5f * leaf.size;
+    for (int c = 0; c < 8; ++c) {
+      const Eigen::Vector3f corner(c & 4 ? h : -h, c & 2 ? h : -h, c & 1 ? h : -h);
+      const Eigen::Vector3f p = leaf.centre + rotation * corner;
+      points->SetPoint(point_id + c, p.x(), p.y(), p.z());
+    }
+    const auto rgb = selseg_apps::segmentColor(leaf.label);
+    for (const auto& face : kFaces) {
+      const vtkIdType ids[4] = {point_id + face[0],
+                                point_id + face[1],
+                                point_id + face[2],
+                                point_id + face[3]};
+      cells->InsertNextCell(4, ids);
+      colors->SetTypedTuple(cell_id++, rgb.data());
+    }
+    point_id += 8;
+  }
+  auto data = PolyData::New();
+  data->SetPoints(points);
+  data->SetPolys(cells);
+  data->GetCellData()->SetScalars(colors);
+  return data;
+}
+
+/** The labeled points as vertices coloured by segment. */
+PolyData
+buildCloud(const Scene& scene)
+{
+  const auto& labels = scene.result.labels;
+  auto points = vtkSmartPointer<vtkPoints>::New();
+  auto cells = vtkSmartPointer<vtkCellArray>::New();
+  auto colors = newColors(0);
+  for (std::size_t i = 0; i < scene.cloud->size(); ++i) {
+    if (labels[i] == 0)
+      continue;
+    const vtkIdType id = points->InsertNextPoint((*scene.cloud)[i].data);
+    cells->InsertNextCell(1, &id);
+    colors->InsertNextTypedTuple(selseg_apps::segmentColor(labels[i]).data());
+  }
+  auto data = PolyData::New();
+  data->SetPoints(points);
+  data->SetVerts(cells);
+  data->GetCellData()->SetScalars(colors);
+  return data;
+}
+
+/** A line along the normal of every step-th labeled point, 10 median point spacings
+ * long, coloured by segment. */
+PolyData
+buildNormals(const Scene& scene, int step)
+{
+  const auto& labels = scene.result.labels;
+  if (step == 0)
+    step = std::max<int>(1, static_cast<int>(scene.result.counts.labeled / 5000));
+  const float length = static_cast<float>(10.0 * scene.result.median_spacing);
+  auto points = vtkSmartPointer<vtkPoints>::New();
+  auto cells = vtkSmartPointer<vtkCellArray>::New();
+  auto colors = newColors(0);
+  std::size_t seen = 0;
+  for (std::size_t i = 0; i < scene.cloud->size(); ++i) {
+    const auto& n = (*scene.normals)[i];
+    if (labels[i] == 0 || !std::isfinite(n.normal_x) || seen++ % step != 0)
+      continue;
+    const Eigen::Vector3f p = (*scene.cloud)[i].getVector3fMap();
+    const Eigen::Vector3f q = p + length * n.getNormalVector3fMap();
+    const vtkIdType ids[2] = {points->InsertNextPoint(p.data()),
+                              points->InsertNextPoint(q.data())};
+    cells->InsertNextCell(2, ids);
+    colors->InsertNextTypedTuple(selseg_apps::segmentColor(labels[i]).data());
+  }
+  auto data = PolyData::New();
+  data->SetPoints(points);
+  data->SetLines(cells);
+  data->GetCellData()->SetScalars(colors);
+  return data;
+}
+
+/** An actor drawing the data's cell colours as they are. */
+vtkSmartPointer<vtkActor>
+newActor(const PolyData& data)
+{
+  auto mapper = vtkSmartPointer<vtkPolyDataMapper>::New();
+  mapper->SetInputData(data);
+  mapper->SetScalarModeToUseCellData();
+  mapper->SetColorModeToDirectScalars();
+  mapper->ScalarVisibilityOn();
+  auto actor = vtkSmartPointer<vtkActor>::New();
+  actor->SetMapper(mapper);
+  return actor;
+}
+
+/** What the sensor's camera shows: the vertical view angle and the window centre (an
+ * off-axis shift, in [-1, 1] viewport units) that frame the labeled points. */
+struct SensorFrame {
+  double view_angle = 60.0 * kDeg; ///< [rad]
+  double centre_x = 0.0;
+  double centre_y = 0.0;
+};
+
+/** The 0.5% and 99.5% quantiles of v, reordering v. */
+std::pair<double, double>
+robustRange(std::vector<float>& v)
+{
+  const auto at = [&v](double q) {
+    const auto nth = v.begin() + static_cast<std::ptrdiff_t>(q * (v.size() - 1));
+    std::nth_element(v.begin(), nth, v.end());
+    return static_cast<double>(*nth);
+  };
+  return {at(0.005), at(0.995)};
+}
+
+/** Frame of a camera at the sensor, looking along its +z axis, that shows 99% of the
+ * labeled points in a window of the given aspect ratio (width / height). */
+SensorFrame
+fitSensorFrame(const Scene& scene, double aspect)
+{
+  const Eigen::Affine3f to_sensor = scene.sensor_pose.inverse();
+  std::vector<float> tan_x, tan_y;
+  for (std::size_t i = 0; i < scene.cloud->size(); ++i) {
+    if (scene.result.labels[i] == 0)
+      continue;
+    const Eigen::Vector3f s = to_sensor * (*scene.cloud)[i].getVector3fMap();
+    tan_x.push_back(s.x() / s.z());
+    tan_y.push_back(s.y() / s.z());
+  }
+  SensorFrame frame;
+  if (tan_x.empty())
+    return frame;
+  const auto [x0, x1] = robustRange(tan_x);
+  const auto [y0, y1] = robustRange(tan_y);
+  const double half = 0.53 * std::max(y1 - y0, (x1 - x0) / aspect);
+  frame.view_angle = std::clamp(2.0 * std::atan(half), 1.0 * kDeg, 150.0 * kDeg);
+  const double half_tan = std::tan(0.5 * frame.view_angle);
+  frame.centre_x = 0.5 * (x0 + x1) / (half_tan * aspect);
+  frame.centre_y = -0.5 * (y0 + y1) / half_tan;
+  return frame;
+}
+
+/** Owns the PCLVisualizer: one actor per layer, the key legend, the sensor camera. */
+class SegmentationViewer {
+public:
+  /** \param[in] offscreen render without a window (for screenshots) */
+  SegmentationViewer(const Scene& scene, const Options& opt, bool offscreen);
+
+  /** Run the interactive loop until the window is closed. */
+  void spin();
+
+  /** Render once and write a PNG. \return false, with a message, on failure. */
+  bool saveScreenshot(const std::string& path);
+
+private:
+  /** Layer keys toggle their layer; b, z and i as the legend says. */
+  void keyboardCallback(const pcl::visualization::KeyboardEvent& event);
+
+  /** Camera at the sensor, looking along its +z axis, its y axis pointing down. */
+  void setSensorCamera();
+
+  /** Octree leaves as outlines or as solid cubes with dark edges. */
+  void setOctreeWireframe(bool wireframe);
+
+  /** The key legend with each layer's state, or nothing when the legend is off. */
+  void updateLegend();
+
+  vtkRenderer* renderer() { return viz_.getRendererCollection()->GetFirstRenderer(); }
+
+  pcl::visualization::PCLVisualizer viz_;
+  const Scene& scene_;
+  std::array<vtkSmartPointer<vtkActor>, kNumLayers> actors_;
+  std::array<bool, kNumLayers> visible_{};
+  std::string summary_;
+  bool octree_wireframe_ = false;
+  bool legend_ = true;
+};
+
+SegmentationViewer::SegmentationViewer(const Scene& scene,
+                                       const Options& opt,
+                                       bool offscreen)
+    : viz_("pcl_selective_seg_viewer: " + opt.input, !offscreen)
+    , scene_(scene)
+    , legend_(opt.legend)
+{
+  if (offscreen)
+    viz_.getRenderWindow()->SetOffScreenRendering(1);
+  viz_.setSize(opt.width, opt.height);
+  viz_.setBackgroundColor(0.0, 0.0, 0.0);
+  viz_.setShowFPS(false);
+  const std::array<PolyData, kNumLayers> data = {buildMesh(scene),
+                                                 buildOctree(scene),
+                                                 buildCloud(scene),
+                                                 buildNormals(scene, opt.normal_step)};
+  for (int layer = 0; layer < kNumLayers; ++layer) {
+    actors_[layer] = newActor(data[layer]);
+    visible_[layer] = opt.view[layer];
+    actors_[layer]->SetVisibility(visible_[layer]);
+    renderer()->AddActor(actors_[layer]);
+  }
+  for (const Layer layer : {kMesh, kOctree}) {
+    actors_[layer]->GetProperty()->SetAmbient(0.35);
+    actors_[layer]->GetProperty()->SetDiffuse(0.65);
+  }
+  actors_[kCloud]->GetProperty()->SetPointSize(2.0);
+  actors_[kNormals]->GetProperty()->LightingOff();
+  actors_[kOctree]->GetProperty()->SetEdgeColor(0.1, 0.1, 0.1);
+  setOctreeWireframe(opt.octree_wireframe);
+  summary_ = std::to_string(scene.result.segments.size()) + " segments, " +
+             std::to_string(scene.result.leaves.size()) + " octree leaves, " +
+             std::to_string(scene.result.mesh.triangles.size()) + " triangles";
+  updateLegend();
+  setSensorCamera();
+  if (!offscreen)
+    viz_.registerKeyboardCallback(
+        [this](const pcl::visualization::KeyboardEvent& e) { keyboardCallback(e); });
+}
+
+void
+SegmentationViewer::spin()
+{
+  while (!viz_.wasStopped())
+    viz_.spinOnce(100);
+}
+
+bool
+SegmentationViewer::saveScreenshot(const std::string& path)
+{
+  if (!std::ofstream(path, std::ios::binary)) {
+    print_error("Cannot write '%s': check that the folder exists and is writable.\n",
+                path.c_str());
+    return false;
+  }
+  auto* window = viz_.getRenderWindow().Get();
+  window->Render();
+  vtkNew<vtkWindowToImageFilter> grab;
+  grab->SetInput(window);
+  grab->SetInputBufferTypeToRGB();
+  grab->ReadFrontBufferOff();
+  grab->Update();
+  vtkNew<vtkPNGWriter> writer;
+  writer->SetCompressionLevel(9);
+  writer->SetFileName(path.c_str());
+  writer->SetInputConnection(grab->GetOutputPort());
+  writer->Write();
+  if (writer->GetErrorCode() != 0) {
+    print_error("Cannot write the PNG '%s' (disk full?).\n", path.c_str());
+    return false;
+  }
+  print_info("Wrote '%s' [%d x %d]\n",
+             path.c_str(),
+             window->GetSize()[0],
+             window->GetSize()[1]);
+  return true;
+}
+
+void
+SegmentationViewer::keyboardCallback(const pcl::visualization::KeyboardEvent& event)
+{
+  if (!event.keyDown())
+    return;
+  const char key = event.getKeyCode();
+  for (int layer = 0; layer < kNumLayers; ++layer)
+    if (key == kLayers[layer].key) {
+      visible_[layer] = !visible_[layer];
+      actors_[layer]->SetVisibility(visible_[layer]);
+      renderer()->ResetCameraClippingRange();
+    }
+  if (key == 'b')
+    setOctreeWireframe(!octree_wireframe_);
+  else if (key == 'z')
+    setSensorCamera();
+  else if (key == 'i')
+    legend_ = !legend_;
+  updateLegend();
+  viz_.getRenderWindow()->Render();
+}
+
+void
+SegmentationViewer::setSensorCamera()
+{
+  const auto& pose = scene_.sensor_pose;
+  const Eigen::Vector3f eye = pose.translation();
+  const Eigen::Vector3f focal = pose * Eigen::Vector3f::UnitZ();
+  const Eigen::Vector3f up = pose.linear() * -Eigen::Vector3f::UnitY();
+  viz_.setCameraPosition(eye.x(),
+                         eye.y(),
+                         eye.z(),
+                         focal.x(),
+                         focal.y(),
+                         focal.z(),
+                         up.x(),
+                         up.y(),
+                         up.z());
+  const int* size = viz_.getRenderWindow()->GetSize();
+  const SensorFrame frame = fitSensorFrame(scene_, double(size[0]) / size[1]);
+  viz_.setCameraFieldOfView(frame.view_angle);
+  renderer()->GetActiveCamera()->SetWindowCenter(frame.centre_x, frame.centre_y);
+  renderer()->ResetCameraClippingRange();
+}
+
+void
+SegmentationViewer::setOctreeWireframe(bool wireframe)
+{
+  octree_wireframe_ = wireframe;
+  auto* property = actors_[kOctree]->GetProperty();
+  if (wireframe) {
+    property->SetRepresentationToWireframe();
+    property->EdgeVisibilityOff();
+    property->LightingOff();
+  } else {
+    property->SetRepresentationToSurface();
+    property->EdgeVisibilityOn();
+    property->LightingOn();
+  }
+}
+
+void
+SegmentationViewer::updateLegend()
+{
+  std::vector<std::string> lines = {summary_};
+  for (int layer = 0; layer < kNumLayers; ++layer)
+    lines.push_back(std::string(1, kLayers[layer].key) + "  " +
+                    kLayers[layer].description + (visible_[layer] ? "  [on]" : ""));
+  lines.push_back(std::string("b  octree as ") +
+                  (octree_wireframe_ ? "outlines" : "solid cubes"));
+  lines.push_back("z  sensor's view   i  legend   q  quit");
+  const int font = 12, step = 16;
+  for (std::size_t k = 0; k < lines.size(); ++k) {
+    const std::string id = "legend" + std::to_string(k);
+    const int y = 8 + step * static_cast<int>(lines.size() - 1 - k);
+    const std::string text = legend_ ? lines[k] : "";
+    if (!viz_.updateText(text, 8, y, font, 1.0, 1.0, 1.0, id))
+      viz_.addText(text, 8, y, font, 1.0, 1.0, 1.0, id);
+  }
+}
+
+} // namespace
+
+int
+main(int argc, char** argv)
+{
+  if (argc < 2 || find_switch(argc, argv, "-h") || find_switch(argc, argv, "--help")) {
+    printHelp(argv[0]);
+    return argc < 2 ? kUsageError : 0;
+  }
+  Options opt;
+  if (const int rc = parseOptions(argc, argv, opt))
+    return rc;
+  Scene scene;
+  if (!loadInput(opt, scene) || !checkDisplay() || !segment(opt, scene))
+    return kRuntimeError;
+  const bool offscreen = !opt.screenshot.empty();
+  SegmentationViewer viewer(scene, opt, offscreen);
+  if (offscreen)
+    return viewer.saveScreenshot(opt.screenshot) ? 0 : kRuntimeError;
+  viewer.spin();
+  return 0;
+}
