@@ -1,0 +1,260 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
+ */
+
+// pcl_selective_seg_simulate: simulate a stereo-like scan of one of the paper's scenes
+// (cube, chair, door) with ground-truth labels, print the per-label point counts and
+// write the labeled cloud.
+//
+// Exit codes: 0 = success, 1 = runtime error (unwritable output), 2 = usage error
+// (bad option).
+
+#include <pcl_selective_seg/sensor_simulator.h>
+
+#include <pcl/console/parse.h>
+#include <pcl/console/print.h>
+#include <pcl/console/time.h>
+#include <pcl/exceptions.h>
+#include <pcl/io/pcd_io.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <iterator>
+#include <map>
+#include <string>
+
+using namespace pcl::console;
+namespace sim = pcl::selective_seg::simulation;
+
+namespace {
+
+constexpr int kRuntimeError = 1;
+constexpr int kUsageError = 2;
+constexpr double kDeg = M_PI / 180.0;
+
+/** Command-line options; the sensor defaults are SensorParameters' defaults. */
+struct Options {
+  sim::PaperScene scene = sim::PaperScene::Cube;
+  double density = 1.0;
+  sim::SensorParameters sensor;
+  std::string output;
+};
+
+void
+printHelp(const char* program)
+{
+  const sim::SensorParameters d;
+  print_info("Simulate a stereo-like scan of one of the paper's scenes, with "
+             "ground-truth labels.\n\nUsage: %s [options]\n\nOptions:\n",
+             program);
+  print_info("  -scene NAME          cube, chair or door (default cube)\n");
+  print_info("  -density X           multiplier of the ray count [-], > 0; 1 gives "
+             "about the paper's point count (default 1)\n");
+  print_info("  -noise K             range noise factor [1/m]: std dev K * r^2 [m] at "
+             "range r [m], in [0, 1] (default %g)\n",
+             d.range_noise);
+  print_info("  -density_ratio X     densest / sparsest angular density [-], in "
+             "[1, 100] (default %g)\n",
+             d.density_ratio);
+  print_info("  -dropout P           probability that a ray returns nothing [-], in "
+             "[0, 1) (default %g)\n",
+             d.dropout);
+  print_info("  -holes N             number of elliptic holes without returns, in "
+             "[0, 1000] (default %d)\n",
+             d.num_holes);
+  print_info("  -hole_radius_deg X   mean semi-axis of a hole [deg], in [0, 57.3] "
+             "(default %g)\n",
+             d.hole_radius / kDeg);
+  print_info("  -seed S              random seed, integer in [0, 4294967295] "
+             "(default %u)\n",
+             d.seed);
+  print_info("  -o FILE.pcd          write the cloud (x y z label [m]); without it, "
+             "only the counts are printed\n");
+  print_info("  -h, --help           this help\n");
+}
+
+/** A checked numeric option: absent is fine, present and unparsable is a usage error.
+ */
+bool
+parseNumber(int argc, char** argv, const char* flag, double& value)
+{
+  if (find_argument(argc, argv, flag) < 0)
+    return true;
+  if (parse_argument(argc, argv, flag, value) < 0 || !std::isfinite(value)) {
+    print_error("Option %s needs a number.\n", flag);
+    return false;
+  }
+  return true;
+}
+
+/** A checked integer option in [lo, hi]. */
+bool
+parseInteger(
+    int argc, char** argv, const char* flag, double lo, double hi, double& value)
+{
+  if (!parseNumber(argc, argv, flag, value))
+    return false;
+  if (value != std::floor(value) || value < lo || value > hi) {
+    print_error("Option %s needs an integer in [%.0f, %.0f].\n", flag, lo, hi);
+    return false;
+  }
+  return true;
+}
+
+/** Every argument is a known option followed by its value. */
+bool
+checkArguments(int argc, char** argv)
+{
+  static const char* const flags[] = {"-scene",
+                                      "-density",
+                                      "-noise",
+                                      "-density_ratio",
+                                      "-dropout",
+                                      "-holes",
+                                      "-hole_radius_deg",
+                                      "-seed",
+                                      "-o"};
+  for (int i = 1; i < argc; i += 2) {
+    const std::string arg = argv[i];
+    if (std::find(std::begin(flags), std::end(flags), arg) == std::end(flags)) {
+      print_error("Unknown argument '%s' (see %s -h).\n", argv[i], argv[0]);
+      return false;
+    }
+    if (i + 1 >= argc) {
+      print_error("Option %s needs a value.\n", argv[i]);
+      return false;
+    }
+  }
+  return true;
+}
+
+/** \return 0 on success, else the exit code. */
+int
+parseOptions(int argc, char** argv, Options& opt)
+{
+  if (!checkArguments(argc, argv))
+    return kUsageError;
+  std::string scene = "cube";
+  parse_argument(argc, argv, "-scene", scene);
+  if (!sim::parsePaperScene(scene, opt.scene)) {
+    print_error("Unknown -scene '%s': use cube, chair or door.\n", scene.c_str());
+    return kUsageError;
+  }
+  auto& s = opt.sensor;
+  double holes = s.num_holes;
+  double seed = s.seed;
+  double hole_radius_deg = s.hole_radius / kDeg;
+  if (!parseNumber(argc, argv, "-density", opt.density) ||
+      !parseNumber(argc, argv, "-noise", s.range_noise) ||
+      !parseNumber(argc, argv, "-density_ratio", s.density_ratio) ||
+      !parseNumber(argc, argv, "-dropout", s.dropout) ||
+      !parseInteger(argc, argv, "-holes", 0.0, 1000.0, holes) ||
+      !parseNumber(argc, argv, "-hole_radius_deg", hole_radius_deg) ||
+      !parseInteger(argc, argv, "-seed", 0.0, 4294967295.0, seed))
+    return kUsageError;
+  if (!(opt.density > 0.0)) {
+    print_error("Option -density needs a value > 0.\n");
+    return kUsageError;
+  }
+  s.num_holes = static_cast<int>(holes);
+  s.seed = static_cast<std::uint32_t>(seed);
+  s.hole_radius = hole_radius_deg * kDeg;
+  parse_argument(argc, argv, "-o", opt.output);
+  return 0;
+}
+
+/** The scene's sensor window and ray count with the options' sensor model. */
+bool
+makeSensor(const Options& opt,
+           const sim::SimulationSetup& setup,
+           sim::SensorParameters& sensor)
+{
+  sensor = opt.sensor;
+  sensor.theta_min = setup.sensor.theta_min;
+  sensor.theta_max = setup.sensor.theta_max;
+  sensor.phi_min = setup.sensor.phi_min;
+  sensor.phi_max = setup.sensor.phi_max;
+  sensor.num_rays = setup.sensor.num_rays;
+  std::string why;
+  if (!sensor.validate(&why)) {
+    print_error("%s\n", why.c_str());
+    return false;
+  }
+  return true;
+}
+
+void
+printCounts(const sim::Scene& scene,
+            const pcl::PointCloud<pcl::PointXYZL>& cloud,
+            const sim::SimulationDetails& details)
+{
+  std::map<std::uint32_t, std::size_t> counts;
+  for (const auto& point : cloud)
+    ++counts[point.label];
+  print_info("Rays: %zu cast, %zu in holes, %zu dropped, %zu missed, %zu out of "
+             "range\n",
+             details.rays,
+             details.in_holes,
+             details.dropped,
+             details.missed,
+             details.out_of_range);
+  for (const auto& [label, name] : scene.label_names)
+    print_info("  label %2u  %-28s %8zu points\n", label, name.c_str(), counts[label]);
+}
+
+/** Write to a temporary name, then rename: no partial file is ever left behind. */
+bool
+saveCloud(const std::string& path, const pcl::PointCloud<pcl::PointXYZL>& cloud)
+{
+  const std::string tmp = path + ".tmp";
+  bool written = false;
+  try {
+    written = pcl::io::savePCDFileBinary(tmp, cloud) == 0;
+  } catch (const pcl::PCLException&) {
+    written = false;
+  }
+  if (!written || std::rename(tmp.c_str(), path.c_str()) != 0) {
+    std::remove(tmp.c_str());
+    print_error("Cannot write '%s': check that the folder exists and is writable.\n",
+                path.c_str());
+    return false;
+  }
+  return true;
+}
+
+} // namespace
+
+int
+main(int argc, char** argv)
+{
+  if (find_switch(argc, argv, "-h") || find_switch(argc, argv, "--help")) {
+    printHelp(argv[0]);
+    return 0;
+  }
+  Options opt;
+  if (const int code = parseOptions(argc, argv, opt))
+    return code;
+  const sim::SimulationSetup setup = sim::makePaperScene(opt.scene, opt.density);
+  sim::SensorSimulator simulator;
+  sim::SensorParameters sensor;
+  if (!makeSensor(opt, setup, sensor) || !simulator.setParameters(sensor))
+    return kUsageError;
+  TicToc timer;
+  timer.tic();
+  print_highlight("Simulating the %s scene ",
+                  sim::getPaperSceneName(opt.scene).c_str());
+  pcl::PointCloud<pcl::PointXYZL> cloud;
+  sim::SimulationDetails details;
+  if (!simulator.simulate(setup.scene, cloud, &details))
+    return kRuntimeError;
+  print_info("[done, %g ms : %zu points]\n", timer.toc(), cloud.size());
+  printCounts(setup.scene, cloud, details);
+  if (!opt.output.empty() && !saveCloud(opt.output, cloud))
+    return kRuntimeError;
+  if (!opt.output.empty())
+    print_info("Wrote %s\n", opt.output.c_str());
+  return 0;
+}
