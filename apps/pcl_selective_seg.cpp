@@ -66,6 +66,7 @@ const OptionSpec kOptions[] = {{"-o", true},
                                {"-voxel_factor", true},
                                {"-min_split_points", true},
                                {"-normal_rings", true},
+                               {"-edge_normal", true},
                                {"-max_depth", true},
                                {"-angle_step_rad", true},
                                {"-backend", true},
@@ -129,6 +130,8 @@ printHelp(const char* program)
   print_info("  -normal_rings N          point normals over the N-ring of mesh "
              "triangles; 1 = paper's eq. 2 (default %d)\n",
              d.normal_rings);
+  print_info("  -edge_normal NAME        normal tested by eq. 8: facet (paper) or "
+             "vertex_mean (noise-robust) (default facet)\n");
   print_info("  -max_depth N             deepest octree level (default %d)\n",
              d.max_octree_depth);
   print_info("  -angle_step_rad X        angle quantization step [rad] (default %g)\n",
@@ -232,6 +235,15 @@ parseAlgorithm(int argc, char** argv, SelectiveSegmentationParameters& p)
       !parseNumber(argc, argv, "-max_depth", p.max_octree_depth) ||
       !parseNumber(argc, argv, "-angle_step_rad", p.angle_quantization))
     return false;
+  std::string edge_normal = "facet";
+  parse_argument(argc, argv, "-edge_normal", edge_normal);
+  if (edge_normal == "vertex_mean")
+    p.edge_triangle_normal = pcl::selective_seg::EdgeTriangleNormal::VertexMean;
+  else if (edge_normal != "facet") {
+    print_error("Unknown -edge_normal '%s': use facet or vertex_mean.\n",
+                edge_normal.c_str());
+    return false;
+  }
   std::string backend = "boost";
   parse_argument(argc, argv, "-backend", backend);
   if (backend == "vtk")

@@ -197,18 +197,26 @@ runMultiPlane(const Cloud::ConstPtr& cloud)
 std::vector<Method>
 methods()
 {
+  using pcl::selective_seg::EdgeTriangleNormal;
   using pcl::selective_seg::SelectiveSegmentationParameters;
   SelectiveSegmentationParameters paper;
   paper.max_view_incidence_angle = 90.0 * kDeg; // the literal paper
   const SelectiveSegmentationParameters defaults;
-  SelectiveSegmentationParameters rings = defaults;
-  rings.normal_rings = 3;
-  return {{"selective (paper)",
-           [paper](const Cloud::ConstPtr& c) { return runSelective(c, paper); }},
-          {"selective (default)",
-           [defaults](const Cloud::ConstPtr& c) { return runSelective(c, defaults); }},
-          {"selective (rings 3)",
-           [rings](const Cloud::ConstPtr& c) { return runSelective(c, rings); }},
+  SelectiveSegmentationParameters rings3 = defaults;
+  rings3.normal_rings = 3;
+  SelectiveSegmentationParameters robust2 = defaults;
+  robust2.normal_rings = 2;
+  robust2.edge_triangle_normal = EdgeTriangleNormal::VertexMean;
+  SelectiveSegmentationParameters robust3 = robust2;
+  robust3.normal_rings = 3;
+  const auto selective = [](const SelectiveSegmentationParameters& p) {
+    return [p](const Cloud::ConstPtr& c) { return runSelective(c, p); };
+  };
+  return {{"selective (paper)", selective(paper)},
+          {"selective (default)", selective(defaults)},
+          {"selective (rings 3)", selective(rings3)},
+          {"selective (rings 2, vertex-mean eq. 8)", selective(robust2)},
+          {"selective (rings 3, vertex-mean eq. 8)", selective(robust3)},
           {"RegionGrowing", runRegionGrowing},
           {"Supervoxel+LCCP", runLccp},
           {"OrganizedMultiPlane", runMultiPlane, true}};

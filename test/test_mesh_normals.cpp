@@ -384,6 +384,21 @@ TEST(MeshNormals, RingNeighbourhoodsWidenEqTwo)
   EXPECT_TRUE(rings2[2].isApprox(Eigen::Vector3f(1, 0.25f, -2).normalized(), 1e-6f));
 }
 
+TEST(MeshNormals, TriangleNormalsFromVertexNormals)
+{
+  using namespace pcl::selective_seg;
+  const std::vector<Triangle> tris{{0, 1, 2}, {1, 2, 3}};
+  const Vector3fVector vertex_normals{Eigen::Vector3f(0, 0, -1),
+                                      Eigen::Vector3f(1, 0, 0),
+                                      Eigen::Vector3f(0, 1, 0),
+                                      Eigen::Vector3f::Constant(kNaN)};
+  Vector3fVector n;
+  computeTriangleNormalsFromVertices(tris, vertex_normals, n);
+  ASSERT_EQ(n.size(), 2u);
+  expectVectorNear(n[0], Eigen::Vector3f(1, 1, -1).normalized());
+  EXPECT_FALSE(n[1].allFinite()); // a vertex without a normal
+}
+
 TEST(MeshNormals, MedianEdgeLength)
 {
   // t0 has edges 1, 2 and sqrt 5; alone its median is 2.

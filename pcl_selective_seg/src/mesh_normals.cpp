@@ -132,6 +132,23 @@ computeVertexNormalsOverRings(std::size_t num_vertices,
 }
 
 void
+computeTriangleNormalsFromVertices(const std::vector<Triangle>& triangles,
+                                   const Vector3fVector& vertex_normals,
+                                   Vector3fVector& normals)
+{
+  normals.resize(triangles.size());
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (const auto v : triangles[t])
+      sum += vertex_normals[v].cast<double>(); // NaN propagates: no normal
+    normals[t] =
+        sum.allFinite()
+            ? normalizedOrNaN(sum)
+            : Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN());
+  }
+}
+
+void
 markEdgeOnTriangles(const Vector3fVector& positions,
                     const std::vector<Triangle>& triangles,
                     const Vector3fVector& normals,

@@ -77,6 +77,15 @@ PCL_EXPORTS void computeVertexNormalsOverRings(std::size_t num_vertices,
                                                int rings,
                                                Vector3fVector& vertex_normals);
 
+/** \brief Triangle normals as the normalized mean of their vertices' normals.
+ * \param[in] triangles #T triangles over vertex ids
+ * \param[in] vertex_normals #V unit normals (NaN: no normal)
+ * \param[out] normals #T unit normals; NaN when a vertex has none or they cancel */
+PCL_EXPORTS void
+computeTriangleNormalsFromVertices(const std::vector<Triangle>& triangles,
+                                   const Vector3fVector& vertex_normals,
+                                   Vector3fVector& normals);
+
 /** \brief Flag the triangles seen edge-on from the viewpoint.
  *
  * A triangle whose normal makes more than \a max_incidence with the line of sight to

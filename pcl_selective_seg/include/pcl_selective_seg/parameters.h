@@ -15,6 +15,15 @@
 namespace pcl {
 namespace selective_seg {
 
+/** \brief Which normal of a triangle eq. 8 compares with the segment normal. */
+enum class EdgeTriangleNormal : std::uint8_t {
+  /** The facet normal, as in the paper. */
+  Facet = 0,
+  /** The normalized mean of the triangle's three point normals (eq. 2, or its k-ring
+   * version): far less sensitive to range noise than a single facet. */
+  VertexMean = 1
+};
+
 /** \brief Every parameter of SelectiveSegmentation, with the paper's defaults.
  *
  * Angles are in radians, lengths in metres (the cloud's unit). docs/parameters.md gives
@@ -47,6 +56,10 @@ struct PCL_EXPORTS SelectiveSegmentationParameters {
    * of the k-ring, which averages range noise over about k^2 times more triangles.
    * Valid: [1, 10]. See docs/parameters.md. */
   int normal_rings = 1;
+
+  /** \brief The triangle normal tested by eq. 8 (valid edge triangles). Default: the
+   * facet normal, as in the paper. */
+  EdgeTriangleNormal edge_triangle_normal = EdgeTriangleNormal::Facet;
 
   /** \brief Smallest octree voxel edge [m]; voxels of this size are never split.
    * 0 = automatic: min_voxel_size_factor times the median 3-D edge length of the

@@ -177,6 +177,9 @@ protected:
                     const Vector3fVector& segment_normals,
                     std::vector<std::uint32_t>& segment_label);
 
+  /** \brief The triangle normals eq. 8 tests (parameter edge_triangle_normal). */
+  const Vector3fVector& edgeTestNormals();
+
   /** \brief Rotation from the sensor frame to the cloud frame. */
   Eigen::Matrix3f sensorToCloud() const { return delaunay_.getSensorPose().rotation(); }
 
@@ -198,6 +201,8 @@ private:
   Vector3fVector triangle_normals_;
   std::vector<double> triangle_areas_;
   std::vector<std::uint8_t> triangle_edge_on_;
+  Vector3fVector
+      vertex_mean_normals_; ///< per triangle, for EdgeTriangleNormal::VertexMean
   std::vector<pcl::index_t> vertex_leaf_;
   SegmentationResult result_;
 };

@@ -247,7 +247,7 @@ SelectiveSegmentation<PointT>::fillMeshAndLeaves(
   for (const auto& s : result_.segments)
     label_normals.push_back(to_cloud.transpose() * s.normal);
   classifyTriangles(tri.triangles,
-                    triangle_normals_,
+                    edgeTestNormals(),
                     &triangle_edge_on_,
                     vertex_labels,
                     label_normals,
@@ -274,6 +274,18 @@ SelectiveSegmentation<PointT>::fillMeshAndLeaves(
 }
 
 template <typename PointT>
+const Vector3fVector&
+SelectiveSegmentation<PointT>::edgeTestNormals()
+{
+  if (params_.edge_triangle_normal == EdgeTriangleNormal::Facet)
+    return triangle_normals_;
+  if (vertex_mean_normals_.size() != triangle_normals_.size())
+    computeTriangleNormalsFromVertices(
+        delaunay_.getTriangulation().triangles, vertex_normals_, vertex_mean_normals_);
+  return vertex_mean_normals_;
+}
+
+template <typename PointT>
 void
 SelectiveSegmentation<PointT>::mergeAndLabel()
 {
@@ -290,7 +302,7 @@ SelectiveSegmentation<PointT>::mergeAndLabel()
   in.leaf_areas = &leaf_areas;
   in.vertex_leaf = &vertex_leaf_;
   in.triangles = &tri.triangles;
-  in.triangle_normals = &triangle_normals_;
+  in.triangle_normals = &edgeTestNormals();
   in.triangle_edge_on = &triangle_edge_on_;
   in.max_merge_angle = params_.max_merge_angle;
   in.max_edge_triangle_angle = params_.max_edge_triangle_angle;
@@ -332,6 +344,7 @@ SelectiveSegmentation<PointT>::extract(std::vector<pcl::PointIndices>& clusters)
   result_.clear();
   octree_.reset();
   normals_.reset();
+  vertex_mean_normals_.clear();
   pcl::StopWatch total;
   if (!initCompute()) {
     this->deinitCompute();
