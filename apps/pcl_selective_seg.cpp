@@ -18,6 +18,7 @@
 #include <pcl/console/print.h>
 #include <pcl/console/time.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstring>
@@ -26,16 +27,15 @@
 
 #include "outputs.h"
 #include "scan_io.h"
+#include "segmentation_options.h"
 
 using namespace pcl::console;
-using pcl::selective_seg::DelaunayBackend;
 using pcl::selective_seg::SelectiveSegmentationParameters;
 
 namespace {
 
 constexpr int kRuntimeError = 1;
 constexpr int kUsageError = 2;
-constexpr double kDeg = M_PI / 180.0;
 
 struct Options {
   std::string input;
@@ -47,34 +47,16 @@ struct Options {
   std::vector<double> sensor_orientation; ///< qw qx qy qz, empty = from the file
 };
 
-/** Every option: its name, whether it takes a value, and its help line. */
-struct OptionSpec {
-  const char* name;
-  bool takes_value;
-};
-const OptionSpec kOptions[] = {{"-o", true},
-                               {"-mesh_ply", true},
-                               {"-mesh_vtk", true},
-                               {"-leaves", true},
-                               {"-json", true},
-                               {"-unit_scale", true},
-                               {"-split_deg", true},
-                               {"-merge_deg", true},
-                               {"-edge_deg", true},
-                               {"-incidence_deg", true},
-                               {"-min_voxel_m", true},
-                               {"-voxel_factor", true},
-                               {"-min_split_points", true},
-                               {"-normal_rings", true},
-                               {"-edge_normal", true},
-                               {"-max_depth", true},
-                               {"-angle_step_rad", true},
-                               {"-backend", true},
-                               {"-sensor_origin", true},
-                               {"-sensor_orientation", true},
-                               {"-ignore_viewpoint", false},
-                               {"-h", false},
-                               {"--help", false}};
+/** The tool's own flags that take a value (besides the segmentation flags). */
+const std::vector<std::string> kValueFlags = {"-o",
+                                              "-mesh_ply",
+                                              "-mesh_vtk",
+                                              "-leaves",
+                                              "-json",
+                                              "-unit_scale",
+                                              "-sensor_origin",
+                                              "-sensor_orientation"};
+const std::vector<std::string> kSwitches = {"-ignore_viewpoint", "-h", "--help"};
 
 void
 printHelp(const char* program)
@@ -105,49 +87,21 @@ printHelp(const char* program)
              "the file's VIEWPOINT)\n"
              "  -ignore_viewpoint        sensor at the origin looking along +z, "
              "whatever the file says\n\n");
-  print_info("Algorithm (defaults are the paper's where it gives one):\n");
-  print_info("  -split_deg X             octree split threshold on the normals' std "
-             "dev [deg] (default %g)\n",
-             d.max_normal_std_dev / kDeg);
-  print_info("  -merge_deg X             max angle between merged segment normals "
-             "[deg] (default %g)\n",
-             d.max_merge_angle / kDeg);
-  print_info("  -edge_deg X              max angle between a valid edge triangle and "
-             "the segment [deg] (default %g)\n",
-             d.max_edge_triangle_angle / kDeg);
-  print_info("  -incidence_deg X         max view incidence of a valid edge triangle "
-             "[deg]; 90 = paper (default %g)\n",
-             d.max_view_incidence_angle / kDeg);
-  print_info("  -min_voxel_m X           smallest octree voxel [m]; 0 = automatic "
-             "(default %g)\n",
-             d.min_voxel_size);
-  print_info("  -voxel_factor X          automatic smallest voxel in median point "
-             "spacings (default %g)\n",
-             d.min_voxel_size_factor);
-  print_info("  -min_split_points N      voxels with fewer points are not split "
-             "(default %d)\n",
-             d.min_points_to_split);
-  print_info("  -normal_rings N          point normals over the N-ring of mesh "
-             "triangles; 1 = paper's eq. 2 (default %d)\n",
-             d.normal_rings);
-  print_info("  -edge_normal NAME        normal tested by eq. 8: facet (paper) or "
-             "vertex_mean (noise-robust) (default facet)\n");
-  print_info("  -max_depth N             deepest octree level (default %d)\n",
-             d.max_octree_depth);
-  print_info("  -angle_step_rad X        angle quantization step [rad] (default %g)\n",
-             d.angle_quantization);
-  print_info("  -backend NAME            Delaunay backend: boost or vtk (default "
-             "boost)\n"
-             "  -h, --help               this help\n");
+  selseg_apps::printSegmentationHelp();
+  print_info("  -h, --help             this help\n");
 }
 
-const OptionSpec*
-findOption(const char* arg)
+/** 1: a flag with a value, 0: a switch, -1: unknown. */
+int
+optionKind(const std::string& arg)
 {
-  for (const auto& o : kOptions)
-    if (std::strcmp(o.name, arg) == 0)
-      return &o;
-  return nullptr;
+  const auto& seg = selseg_apps::segmentationFlags();
+  const auto in = [&](const std::vector<std::string>& v) {
+    return std::find(v.begin(), v.end(), arg) != v.end();
+  };
+  if (in(kValueFlags) || in(seg))
+    return 1;
+  return in(kSwitches) ? 0 : -1;
 }
 
 /** The one positional argument; unknown options are usage errors. */
@@ -157,13 +111,13 @@ findInput(int argc, char** argv, std::string& input)
   std::vector<std::string> positional;
   for (int i = 1; i < argc; ++i) {
     if (argv[i][0] == '-' && argv[i][1] != '\0' && !std::isdigit(argv[i][1])) {
-      const OptionSpec* o = findOption(argv[i]);
-      if (!o) {
+      const int kind = optionKind(argv[i]);
+      if (kind < 0) {
         print_error("Unknown option '%s' (see -h).\n", argv[i]);
         return false;
       }
-      if (o->takes_value && ++i >= argc) {
-        print_error("Option %s needs a value (see -h).\n", o->name);
+      if (kind == 1 && ++i >= argc) {
+        print_error("Option %s needs a value (see -h).\n", argv[i - 1]);
         return false;
       }
       continue;
@@ -175,31 +129,6 @@ findInput(int argc, char** argv, std::string& input)
     return false;
   }
   input = positional.front();
-  return true;
-}
-
-/** A checked number: absent is fine, present and not a finite number is an error. */
-template <typename T>
-bool
-parseNumber(int argc, char** argv, const char* flag, T& value)
-{
-  if (find_argument(argc, argv, flag) < 0)
-    return true;
-  if (parse_argument(argc, argv, flag, value) < 0 ||
-      !std::isfinite(static_cast<double>(value))) {
-    print_error("Option %s needs a number.\n", flag);
-    return false;
-  }
-  return true;
-}
-
-bool
-parseDegrees(int argc, char** argv, const char* flag, double& radians)
-{
-  double degrees = radians / kDeg;
-  if (!parseNumber(argc, argv, flag, degrees))
-    return false;
-  radians = degrees * kDeg;
   return true;
 }
 
@@ -221,45 +150,6 @@ parseVector(
   return true;
 }
 
-bool
-parseAlgorithm(int argc, char** argv, SelectiveSegmentationParameters& p)
-{
-  if (!parseDegrees(argc, argv, "-split_deg", p.max_normal_std_dev) ||
-      !parseDegrees(argc, argv, "-merge_deg", p.max_merge_angle) ||
-      !parseDegrees(argc, argv, "-edge_deg", p.max_edge_triangle_angle) ||
-      !parseDegrees(argc, argv, "-incidence_deg", p.max_view_incidence_angle) ||
-      !parseNumber(argc, argv, "-min_voxel_m", p.min_voxel_size) ||
-      !parseNumber(argc, argv, "-voxel_factor", p.min_voxel_size_factor) ||
-      !parseNumber(argc, argv, "-min_split_points", p.min_points_to_split) ||
-      !parseNumber(argc, argv, "-normal_rings", p.normal_rings) ||
-      !parseNumber(argc, argv, "-max_depth", p.max_octree_depth) ||
-      !parseNumber(argc, argv, "-angle_step_rad", p.angle_quantization))
-    return false;
-  std::string edge_normal = "facet";
-  parse_argument(argc, argv, "-edge_normal", edge_normal);
-  if (edge_normal == "vertex_mean")
-    p.edge_triangle_normal = pcl::selective_seg::EdgeTriangleNormal::VertexMean;
-  else if (edge_normal != "facet") {
-    print_error("Unknown -edge_normal '%s': use facet or vertex_mean.\n",
-                edge_normal.c_str());
-    return false;
-  }
-  std::string backend = "boost";
-  parse_argument(argc, argv, "-backend", backend);
-  if (backend == "vtk")
-    p.delaunay_backend = DelaunayBackend::Vtk;
-  else if (backend != "boost") {
-    print_error("Unknown -backend '%s': use boost or vtk.\n", backend.c_str());
-    return false;
-  }
-  std::string why;
-  if (!p.validate(&why)) {
-    print_error("%s\n", why.c_str());
-    return false;
-  }
-  return true;
-}
-
 /** \return 0 on success, else the exit code. */
 int
 parseOptions(int argc, char** argv, Options& opt)
@@ -272,7 +162,7 @@ parseOptions(int argc, char** argv, Options& opt)
   parse_argument(argc, argv, "-leaves", opt.leaves);
   parse_argument(argc, argv, "-json", opt.json);
   opt.ignore_viewpoint = find_switch(argc, argv, "-ignore_viewpoint");
-  if (!parseNumber(argc, argv, "-unit_scale", opt.unit_scale) ||
+  if (!selseg_apps::parseNumber(argc, argv, "-unit_scale", opt.unit_scale) ||
       !(opt.unit_scale > 0.0) ||
       !parseVector(argc, argv, "-sensor_origin", 3, opt.sensor_origin) ||
       !parseVector(argc, argv, "-sensor_orientation", 4, opt.sensor_orientation)) {
@@ -280,7 +170,8 @@ parseOptions(int argc, char** argv, Options& opt)
       print_error("Option -unit_scale needs a positive number.\n");
     return kUsageError;
   }
-  return parseAlgorithm(argc, argv, opt.params) ? 0 : kUsageError;
+  return selseg_apps::parseSegmentationOptions(argc, argv, opt.params) ? 0
+                                                                       : kUsageError;
 }
 
 /** The sensor pose from the options, or false to keep the file's. */

@@ -49,6 +49,7 @@
 
 #include "scan_io.h"
 #include "segment_colors.h"
+#include "segmentation_options.h"
 
 using namespace pcl::console;
 using pcl::selective_seg::SegmentationResult;
@@ -106,7 +107,6 @@ void
 printHelp(const char* program)
 {
   const Options d;
-  const SelectiveSegmentationParameters p;
   print_info(
       "Segment a 3-D scan seen from one sensor and show the segments, as the\n"
       "mesh (edge triangles white) and as the labeled octree, from the sensor.\n\n"
@@ -118,27 +118,7 @@ printHelp(const char* program)
              d.unit_scale);
   print_info("  -ignore_viewpoint      sensor at the origin looking along +z, whatever "
              "the file's VIEWPOINT says (default off)\n");
-  print_info("Segmentation (defaults are the paper's where it gives one):\n");
-  print_info("  -split_deg X           octree split threshold on the normals' std dev "
-             "[deg] (default %.1f)\n",
-             p.max_normal_std_dev / kDeg);
-  print_info("  -merge_deg X           max angle between merged segment normals [deg] "
-             "(default %.1f)\n",
-             p.max_merge_angle / kDeg);
-  print_info("  -edge_deg X            max angle of a valid edge triangle [deg] "
-             "(default %.1f)\n",
-             p.max_edge_triangle_angle / kDeg);
-  print_info("  -incidence_deg X       max view incidence of a valid edge triangle "
-             "[deg]; 90 = off (default %.1f)\n",
-             p.max_view_incidence_angle / kDeg);
-  print_info("  -min_voxel_m X         smallest octree voxel [m]; 0 = %.1f x median "
-             "point spacing (default %g)\n",
-             p.min_voxel_size_factor,
-             p.min_voxel_size);
-  print_info(
-      "  -normal_rings N        point normals over the N-ring of mesh triangles; "
-      "1 = the paper [rings] (default %d)\n",
-      p.normal_rings);
+  selseg_apps::printSegmentationHelp();
   print_info("Display:\n");
   print_info("  -view LAYER[,LAYER]    layers shown at start: mesh, octree, cloud, "
              "normals (default mesh)\n");
@@ -156,31 +136,6 @@ printHelp(const char* program)
   print_info("  -h, --help             this help\n\n");
   print_info("Keys: t mesh, v octree, d data points, n normals, b solid/outline "
              "cubes,\n      z back to the sensor's view, i legend; q quits.\n");
-}
-
-/** A checked numeric option: absent is fine, present and unparsable is a usage error.
- */
-template <typename T>
-bool
-parseChecked(int argc, char** argv, const char* flag, T& value)
-{
-  if (find_argument(argc, argv, flag) < 0)
-    return true;
-  if (parse_argument(argc, argv, flag, value) < 0 || !std::isfinite(double(value))) {
-    print_error("Option %s needs a number (see -h).\n", flag);
-    return false;
-  }
-  return true;
-}
-
-bool
-parseDegrees(int argc, char** argv, const char* flag, double& radians)
-{
-  double degrees = radians / kDeg;
-  if (!parseChecked(argc, argv, flag, degrees))
-    return false;
-  radians = degrees * kDeg;
-  return true;
 }
 
 /** "-size WxH": two integers in [64, 8192]. */
@@ -232,18 +187,11 @@ parseView(int argc, char** argv, Options& opt)
 bool
 isValueFlag(const std::string& arg)
 {
-  static const std::vector<std::string> flags = {"-unit_scale",
-                                                 "-split_deg",
-                                                 "-merge_deg",
-                                                 "-edge_deg",
-                                                 "-incidence_deg",
-                                                 "-min_voxel_m",
-                                                 "-normal_rings",
-                                                 "-view",
-                                                 "-normal_step",
-                                                 "-screenshot",
-                                                 "-size"};
-  return std::find(flags.begin(), flags.end(), arg) != flags.end();
+  static const std::vector<std::string> flags = {
+      "-unit_scale", "-view", "-normal_step", "-screenshot", "-size"};
+  const auto& seg = selseg_apps::segmentationFlags();
+  return std::find(flags.begin(), flags.end(), arg) != flags.end() ||
+         std::find(seg.begin(), seg.end(), arg) != seg.end();
 }
 
 bool
@@ -286,14 +234,9 @@ parseOptions(int argc, char** argv, Options& opt)
   if (!parseInput(argc, argv, opt))
     return kUsageError;
   auto& p = opt.params;
-  if (!parseChecked(argc, argv, "-unit_scale", opt.unit_scale) ||
-      !parseDegrees(argc, argv, "-split_deg", p.max_normal_std_dev) ||
-      !parseDegrees(argc, argv, "-merge_deg", p.max_merge_angle) ||
-      !parseDegrees(argc, argv, "-edge_deg", p.max_edge_triangle_angle) ||
-      !parseDegrees(argc, argv, "-incidence_deg", p.max_view_incidence_angle) ||
-      !parseChecked(argc, argv, "-min_voxel_m", p.min_voxel_size) ||
-      !parseChecked(argc, argv, "-normal_rings", p.normal_rings) ||
-      !parseChecked(argc, argv, "-normal_step", opt.normal_step) ||
+  if (!selseg_apps::parseNumber(argc, argv, "-unit_scale", opt.unit_scale) ||
+      !selseg_apps::parseSegmentationOptions(argc, argv, p) ||
+      !selseg_apps::parseNumber(argc, argv, "-normal_step", opt.normal_step) ||
       !parseSize(argc, argv, opt) || !parseView(argc, argv, opt))
     return kUsageError;
   if (opt.unit_scale <= 0.0) {
@@ -302,11 +245,6 @@ parseOptions(int argc, char** argv, Options& opt)
   }
   if (opt.normal_step < 0) {
     print_error("Option -normal_step must be 0 (automatic) or positive.\n");
-    return kUsageError;
-  }
-  std::string why;
-  if (!p.validate(&why)) {
-    print_error("%s\n", why.c_str());
     return kUsageError;
   }
   parse_argument(argc, argv, "-screenshot", opt.screenshot);

@@ -18,7 +18,7 @@
 #include <string>
 
 #include <leakage.h>
-#include <synthetic_scenes.h>
+#include <cube_scene.h>
 
 namespace {
 
@@ -65,10 +65,7 @@ main(int argc, char** argv)
               "(segments), 85 deg |\n|---|---|---|---|\n");
   for (const std::size_t rays : {5432, 46255})
     for (const unsigned seed : {1u, 2u, 3u}) {
-      auto view = selseg_test::makeCubeOnTableView(rays);
-      view.seed = seed;
-      auto cloud = pcl::make_shared<pcl::PointCloud<pcl::PointXYZL>>(
-          selseg_test::scan(selseg_test::makeCubeOnTableScene(), view));
+      const auto cloud = selseg_test::cubeScan(rays, seed);
       row("cube, seed " + std::to_string(seed), cloud);
     }
   if (argc > 1)

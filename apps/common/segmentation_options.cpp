@@ -1,0 +1,145 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
+ */
+
+#include "segmentation_options.h"
+
+namespace selseg_apps {
+namespace {
+
+using pcl::console::print_error;
+using pcl::console::print_info;
+using pcl::selective_seg::DelaunayBackend;
+using pcl::selective_seg::EdgeTriangleNormal;
+using pcl::selective_seg::SelectiveSegmentationParameters;
+
+constexpr double kDeg = M_PI / 180.0;
+
+bool
+parseDegrees(int argc, char** argv, const char* flag, double& radians)
+{
+  double degrees = radians / kDeg;
+  if (!parseNumber(argc, argv, flag, degrees))
+    return false;
+  radians = degrees * kDeg;
+  return true;
+}
+
+/** A named choice: absent keeps \a value; an unknown name is an error. */
+template <typename Enum>
+bool
+parseChoice(int argc,
+            char** argv,
+            const char* flag,
+            const std::vector<std::pair<std::string, Enum>>& choices,
+            Enum& value)
+{
+  std::string name;
+  if (pcl::console::parse_argument(argc, argv, flag, name) < 0)
+    return true;
+  for (const auto& c : choices)
+    if (c.first == name) {
+      value = c.second;
+      return true;
+    }
+  print_error("Unknown %s '%s' (see -h).\n", flag, name.c_str());
+  return false;
+}
+
+} // namespace
+
+const std::vector<std::string>&
+segmentationFlags()
+{
+  static const std::vector<std::string> flags = {"-split_deg",
+                                                 "-merge_deg",
+                                                 "-edge_deg",
+                                                 "-incidence_deg",
+                                                 "-normal_rings",
+                                                 "-edge_normal",
+                                                 "-min_voxel_m",
+                                                 "-voxel_factor",
+                                                 "-max_depth",
+                                                 "-angle_step_rad",
+                                                 "-min_split_points",
+                                                 "-backend"};
+  return flags;
+}
+
+void
+printSegmentationHelp()
+{
+  const SelectiveSegmentationParameters d;
+  print_info("Segmentation (defaults are the paper's where it gives one; "
+             "docs/parameters.md):\n");
+  print_info("  -split_deg X           octree split threshold on the normals' std dev "
+             "[deg] (default %g)\n",
+             d.max_normal_std_dev / kDeg);
+  print_info("  -merge_deg X           max angle between merged segment normals [deg] "
+             "(default %g)\n",
+             d.max_merge_angle / kDeg);
+  print_info("  -edge_deg X            max angle between a valid edge triangle and the "
+             "segment [deg] (default %g)\n",
+             d.max_edge_triangle_angle / kDeg);
+  print_info("  -incidence_deg X       max view incidence of a valid edge triangle "
+             "[deg]; 90 = paper (default %g)\n",
+             d.max_view_incidence_angle / kDeg);
+  print_info("  -normal_rings N        point normals over the N-ring of triangles; 1 = "
+             "paper's eq. 2 (default %d)\n",
+             d.normal_rings);
+  print_info("  -edge_normal NAME      normal tested by eq. 8: facet (paper) or "
+             "vertex_mean (noise-robust) (default facet)\n");
+  print_info("  -min_voxel_m X         smallest octree voxel [m]; 0 = automatic "
+             "(default %g)\n",
+             d.min_voxel_size);
+  print_info("  -voxel_factor X        automatic smallest voxel in median point "
+             "spacings (default %g)\n",
+             d.min_voxel_size_factor);
+  print_info("  -min_split_points N    voxels with fewer points are not split "
+             "(default %d)\n",
+             d.min_points_to_split);
+  print_info("  -max_depth N           deepest octree level (default %d)\n",
+             d.max_octree_depth);
+  print_info("  -angle_step_rad X      angle quantization step [rad] (default %g)\n",
+             d.angle_quantization);
+  print_info(
+      "  -backend NAME          Delaunay backend: boost or vtk (default boost)\n");
+}
+
+bool
+parseSegmentationOptions(int argc, char** argv, SelectiveSegmentationParameters& p)
+{
+  if (!parseDegrees(argc, argv, "-split_deg", p.max_normal_std_dev) ||
+      !parseDegrees(argc, argv, "-merge_deg", p.max_merge_angle) ||
+      !parseDegrees(argc, argv, "-edge_deg", p.max_edge_triangle_angle) ||
+      !parseDegrees(argc, argv, "-incidence_deg", p.max_view_incidence_angle) ||
+      !parseNumber(argc, argv, "-normal_rings", p.normal_rings) ||
+      !parseNumber(argc, argv, "-min_voxel_m", p.min_voxel_size) ||
+      !parseNumber(argc, argv, "-voxel_factor", p.min_voxel_size_factor) ||
+      !parseNumber(argc, argv, "-min_split_points", p.min_points_to_split) ||
+      !parseNumber(argc, argv, "-max_depth", p.max_octree_depth) ||
+      !parseNumber(argc, argv, "-angle_step_rad", p.angle_quantization) ||
+      !parseChoice(argc,
+                   argv,
+                   "-edge_normal",
+                   {{"facet", EdgeTriangleNormal::Facet},
+                    {"vertex_mean", EdgeTriangleNormal::VertexMean}},
+                   p.edge_triangle_normal) ||
+      !parseChoice(
+          argc,
+          argv,
+          "-backend",
+          {{"boost", DelaunayBackend::BoostVoronoi}, {"vtk", DelaunayBackend::Vtk}},
+          p.delaunay_backend))
+    return false;
+  std::string why;
+  if (!p.validate(&why)) {
+    print_error("%s\n", why.c_str());
+    return false;
+  }
+  return true;
+}
+
+} // namespace selseg_apps

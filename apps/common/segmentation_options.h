@@ -1,0 +1,49 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
+ */
+
+#pragma once
+
+#include <pcl_selective_seg/parameters.h>
+
+#include <pcl/console/parse.h>
+#include <pcl/console/print.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+namespace selseg_apps {
+
+/** \brief A checked number: absent is fine; present and not a finite number prints an
+ * error and returns false (pcl::console::parse_argument alone would store 0). */
+template <typename T>
+bool
+parseNumber(int argc, char** argv, const char* flag, T& value)
+{
+  if (pcl::console::find_argument(argc, argv, flag) < 0)
+    return true;
+  if (pcl::console::parse_argument(argc, argv, flag, value) < 0 ||
+      !std::isfinite(static_cast<double>(value))) {
+    pcl::console::print_error("Option %s needs a number (see -h).\n", flag);
+    return false;
+  }
+  return true;
+}
+
+/** \brief The flags of the segmentation parameters shared by the tools (each takes a
+ * value). */
+const std::vector<std::string>& segmentationFlags();
+
+/** \brief Print the help lines of those flags, with units and defaults. */
+void printSegmentationHelp();
+
+/** \brief Read those flags into \a params (degrees on the command line, radians in the
+ * struct) and validate the result.
+ * \return false, after printing what is wrong, on a bad value */
+bool parseSegmentationOptions(
+    int argc, char** argv, pcl::selective_seg::SelectiveSegmentationParameters& params);
+
+} // namespace selseg_apps
