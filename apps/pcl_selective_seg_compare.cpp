@@ -231,19 +231,25 @@ row(const std::string& scene,
 {
   namespace m = pcl::selective_seg::metrics;
   if (!run.ok)
-    return "| " + scene + " | " + method + " | failed |||||||||||\n";
+    return "| " + scene + " | " + method + " | failed ||||||||||||\n";
   m::HooverScores h;
   m::hooverMetrics(run.labels, truth, 0.8, h);
+  std::vector<m::HooverScores> sweep;
+  m::hooverSweep(run.labels, truth, sweep);
+  std::string correct_by_tolerance;
+  for (const auto& t : sweep)
+    correct_by_tolerance += (correct_by_tolerance.empty() ? "" : " ") +
+                            std::to_string(t.correct_detections);
   m::ObjectScores o;
   m::ObjectMetricsParams params;
   params.boundary_radius = params.boundary_match_distance = 0.02;
   m::objectMetrics(cloud, run.labels, truth, params, o);
-  char line[512];
+  char line[640];
   std::snprintf(
       line,
       sizeof(line),
       "| %s | %s | %.3f | %zu | %zu | %zu | %zu | %zu | %zu | %.2f%% | %.2f | "
-      "%zu | %.2f |\n",
+      "%zu | %.2f | %s |\n",
       scene.c_str(),
       method.c_str(),
       run.seconds,
@@ -256,14 +262,16 @@ row(const std::string& scene,
       100.0 * o.under_segmentation.error,
       o.boundary.recall,
       o.coverage.segments,
-      o.parts.fraction);
+      o.parts.fraction,
+      correct_by_tolerance.c_str());
   return line;
 }
 
 const char* kHeader =
     "| scene | method | time (s) | segments | correct | over | under | missed | noise "
-    "| under-seg. error | boundary recall | segments for 90% | recoverable parts |\n"
-    "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+    "| under-seg. error | boundary recall | segments for 90% | recoverable parts "
+    "| correct at T = 0.50, 0.55, ..., 0.95 |\n"
+    "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
 
 bool
 evaluate(const std::string& path, std::string& table)
