@@ -143,8 +143,12 @@ TEST_F(Tool, UnreadableInputIsARuntimeErrorWithNoOutput)
   EXPECT_EQ(run(out("broken.pcd") + " -o " + out("labels.pcd")), 1);
   std::ofstream(out("broken.xyz")) << "1 2 3\n4 five 6\n";
   EXPECT_EQ(run(out("broken.xyz") + " -o " + out("labels.pcd")), 1);
+  pcl::PointCloud<pcl::Intensity> no_xyz;
+  no_xyz.resize(10);
+  ASSERT_EQ(pcl::io::savePCDFileASCII(out("no_xyz.pcd"), no_xyz), 0);
+  EXPECT_EQ(run(out("no_xyz.pcd") + " -o " + out("labels.pcd")), 1);
   EXPECT_FALSE(fs::exists(out("labels.pcd")));
-  EXPECT_EQ(files(), 2u); // only the two broken inputs
+  EXPECT_EQ(files(), 3u); // only the three broken inputs
 }
 
 TEST_F(Tool, NoUsablePointIsARuntimeError)
