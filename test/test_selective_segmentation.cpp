@@ -143,6 +143,23 @@ TEST(SelectiveSegmentation, ShuffledInputGivesIdenticalSegments)
   EXPECT_EQ(a.getResult().leaves.size(), b.getResult().leaves.size());
 }
 
+TEST(SelectiveSegmentation, ThreadCountDoesNotChangeTheResult)
+{
+  const auto cloud = cubeScene(20000, 8);
+  std::vector<std::vector<std::uint32_t>> labels;
+  for (const int threads : {1, 2, 3}) {
+    SelectiveSegmentation<pcl::PointXYZL> seg;
+    auto p = seg.getParameters();
+    p.num_threads = threads;
+    seg.setParameters(p);
+    std::vector<pcl::PointIndices> clusters;
+    ASSERT_TRUE(segment<pcl::PointXYZL>(cloud, seg, clusters));
+    labels.push_back(seg.getResult().labels);
+  }
+  EXPECT_EQ(labels[0], labels[1]);
+  EXPECT_EQ(labels[0], labels[2]);
+}
+
 TEST(SelectiveSegmentation, LabelsMeshAndOctreeAgree)
 {
   const auto cloud = cubeScene(20000, 3);

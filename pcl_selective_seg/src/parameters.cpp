@@ -59,6 +59,8 @@ SelectiveSegmentationParameters::validate(std::string* why) const
   if (!inRange(angle_quantization, 2.5e-8, 1e-2))
     return reject(
         why, "angle_quantization [rad]", angle_quantization, "[2.5e-8, 1e-2]");
+  if (num_threads < 0 || num_threads > 1024)
+    return reject(why, "num_threads", num_threads, "[0, 1024], 0 = all cores");
   if (!isDelaunayBackendAvailable(delaunay_backend)) {
     if (why)
       *why = std::string("parameter delaunay_backend = ") + toString(delaunay_backend) +

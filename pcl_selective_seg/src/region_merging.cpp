@@ -7,8 +7,8 @@
 #include <pcl_selective_seg/region_merging.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
-#include <deque>
 #include <numeric>
 
 namespace pcl {
@@ -82,12 +82,56 @@ seedOrder(const Incidence& leaf_vertices)
   return order;
 }
 
+/** The leaves of each triangle's vertices (-1: none), and the triangles at each leaf:
+ * every triangle listed once under each distinct leaf of its vertices, in increasing
+ * triangle order. */
+struct LeafTriangles {
+  std::vector<std::array<pcl::index_t, 3>> triangle_leaves;
+  Incidence leaf_triangles;
+
+  LeafTriangles(const MergeInput& in)
+  {
+    const auto& tris = *in.triangles;
+    triangle_leaves.resize(tris.size());
+    const std::size_t num_leaves = in.leaf_normals->size();
+    leaf_triangles.offsets.assign(num_leaves + 1, 0);
+    for (std::size_t t = 0; t < tris.size(); ++t) {
+      auto& leaves = triangle_leaves[t];
+      for (int i = 0; i < 3; ++i)
+        leaves[i] = (*in.vertex_leaf)[tris[t][i]];
+      forEachDistinct(leaves, [&](pcl::index_t l) { ++leaf_triangles.offsets[l + 1]; });
+    }
+    std::partial_sum(leaf_triangles.offsets.begin(),
+                     leaf_triangles.offsets.end(),
+                     leaf_triangles.offsets.begin());
+    leaf_triangles.items.resize(leaf_triangles.offsets.back());
+    std::vector<std::size_t> next(leaf_triangles.offsets.begin(),
+                                  leaf_triangles.offsets.end() - 1);
+    for (std::size_t t = 0; t < tris.size(); ++t)
+      forEachDistinct(triangle_leaves[t], [&](pcl::index_t l) {
+        leaf_triangles.items[next[l]++] = static_cast<pcl::index_t>(t);
+      });
+  }
+
+  /** Call f once for each distinct non-negative leaf of a triangle. */
+  template <typename F>
+  static void forEachDistinct(const std::array<pcl::index_t, 3>& l, F f)
+  {
+    if (l[0] >= 0)
+      f(l[0]);
+    if (l[1] >= 0 && l[1] != l[0])
+      f(l[1]);
+    if (l[2] >= 0 && l[2] != l[0] && l[2] != l[1])
+      f(l[2]);
+  }
+};
+
 class SeedMerger {
 public:
   explicit SeedMerger(const MergeInput& in)
       : in_(in)
       , leaf_vertices_(Incidence::build(*in.vertex_leaf, in.leaf_normals->size()))
-      , vertex_triangles_(vertexTriangles(*in.triangles, in.vertex_leaf->size()))
+      , adjacency_(in)
       , cos_merge_(std::cos(in.max_merge_angle))
       , cos_edge_(std::cos(in.max_edge_triangle_angle))
   {
@@ -106,51 +150,43 @@ public:
   }
 
 private:
+  /** Breadth first from the seed; queue_ is reused across segments. */
   Eigen::Vector3d
   grow(pcl::index_t seed, pcl::index_t k, std::vector<pcl::index_t>& leaf_segment)
   {
     GrowingSegment segment;
     segment.add((*in_.leaf_normals)[seed], (*in_.leaf_areas)[seed]);
     leaf_segment[seed] = k;
-    std::deque<pcl::index_t> queue{seed};
-    while (!queue.empty()) {
-      const auto leaf = queue.front();
-      queue.pop_front();
-      for (auto i = leaf_vertices_.offsets[leaf]; i < leaf_vertices_.offsets[leaf + 1];
-           ++i)
-        visitVertex(leaf_vertices_.items[i], k, segment, leaf_segment, queue);
+    queue_.assign(1, seed);
+    for (std::size_t head = 0; head < queue_.size(); ++head) {
+      const auto leaf = queue_[head];
+      const auto& inc = adjacency_.leaf_triangles;
+      for (auto i = inc.offsets[leaf]; i < inc.offsets[leaf + 1]; ++i)
+        visitTriangle(inc.items[i], k, segment, leaf_segment);
     }
     return segment.normal;
   }
 
-  void visitVertex(pcl::index_t vertex,
-                   pcl::index_t k,
-                   GrowingSegment& segment,
-                   std::vector<pcl::index_t>& leaf_segment,
-                   std::deque<pcl::index_t>& queue)
+  void visitTriangle(pcl::index_t t,
+                     pcl::index_t k,
+                     GrowingSegment& segment,
+                     std::vector<pcl::index_t>& leaf_segment)
   {
-    const auto& vertex_leaf = *in_.vertex_leaf;
-    for (auto i = vertex_triangles_.offsets[vertex];
-         i < vertex_triangles_.offsets[vertex + 1];
-         ++i) {
-      const auto t = vertex_triangles_.items[i];
-      const Triangle& tri = (*in_.triangles)[t];
-      const bool edge = std::any_of(tri.begin(), tri.end(), [&](pcl::index_t v) {
-        return vertex_leaf[v] >= 0 && leaf_segment[vertex_leaf[v]] != k;
-      });
-      if (!edge || !isValidFor(t, segment.normal))
-        continue; // interior, or an invalid edge triangle (eq. 8)
-      for (const auto v : tri) {
-        const auto other = vertex_leaf[v];
-        if (other < 0 || leaf_segment[other] >= 0)
-          continue;
-        const Eigen::Vector3f& n_other = (*in_.leaf_normals)[other];
-        if (n_other.cast<double>().dot(segment.normal) < cos_merge_)
-          continue;              // eq. 9
-        leaf_segment[other] = k; // eq. 10
-        segment.add(n_other, (*in_.leaf_areas)[other]);
-        queue.push_back(other);
-      }
+    const auto& leaves = adjacency_.triangle_leaves[t];
+    const bool edge = std::any_of(leaves.begin(), leaves.end(), [&](pcl::index_t l) {
+      return l >= 0 && leaf_segment[l] != k;
+    });
+    if (!edge || !isValidFor(t, segment.normal))
+      return; // interior, or an invalid edge triangle (eq. 8)
+    for (const auto other : leaves) {
+      if (other < 0 || leaf_segment[other] >= 0)
+        continue;
+      const Eigen::Vector3f& n_other = (*in_.leaf_normals)[other];
+      if (n_other.cast<double>().dot(segment.normal) < cos_merge_)
+        continue;              // eq. 9
+      leaf_segment[other] = k; // eq. 10
+      segment.add(n_other, (*in_.leaf_areas)[other]);
+      queue_.push_back(other);
     }
   }
 
@@ -164,7 +200,8 @@ private:
 
   const MergeInput& in_;
   Incidence leaf_vertices_;
-  Incidence vertex_triangles_;
+  LeafTriangles adjacency_;
+  std::vector<pcl::index_t> queue_;
   double cos_merge_;
   double cos_edge_;
 };

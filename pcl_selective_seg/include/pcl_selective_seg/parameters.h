@@ -83,6 +83,10 @@ struct PCL_EXPORTS SelectiveSegmentationParameters {
    * Default 1e-7 rad (0.1 micrometre at 1 m). Valid: [2.5e-8, 1e-2]. */
   double angle_quantization = 1e-7;
 
+  /** \brief Threads for the parallel stages; 0 = all cores. The result is identical
+   * for any value. Valid: [0, 1024]. */
+  int num_threads = 0;
+
   /** \brief Triangulation backend. */
   DelaunayBackend delaunay_backend = DelaunayBackend::BoostVoronoi;
 

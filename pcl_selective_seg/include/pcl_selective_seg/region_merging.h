@@ -41,8 +41,8 @@ struct MergeInput {
  * within max_edge_triangle_angle of N_Sk (valid edge, eq. 8), each unassigned seed at
  * its vertices joins S_k when its normal is within max_merge_angle of N_Sk (eq. 9-10).
  * N_Sk is the normalized sum of N_v / A_v over its seeds (eq. 7), updated at every
- * join. Each seed joins once and each triangle is examined at most once per vertex:
- * linear in the mesh size.
+ * join. Each seed joins once and each triangle is examined at most once per leaf of
+ * its vertices: linear in the mesh size.
  *
  * \param[in] input the seeds and the mesh
  * \param[out] leaf_segment #L segment id of each seed, 0..#S-1 in creation order

@@ -11,10 +11,19 @@
 #include <Eigen/Geometry>
 #include <pcl/surface/reconstruction.h>
 
+#include <algorithm>
+#include <thread>
 #include <vector>
 
 namespace pcl {
 namespace selective_seg {
+
+/** \brief The number of hardware threads, at least 1. */
+inline unsigned int
+defaultThreads()
+{
+  return std::max(1u, std::thread::hardware_concurrency());
+}
 
 /** \brief Why a point has no mesh vertex (values of
  * SphericalTriangulation::point_vertex). */
@@ -82,6 +91,13 @@ public:
   void setAngleQuantization(double step) { angle_quantization_ = step; }
   double getAngleQuantization() const { return angle_quantization_; }
 
+  /** \brief Threads for the projection (0: all cores). The result does not depend on
+   * it. */
+  void setNumberOfThreads(unsigned int threads)
+  {
+    num_threads_ = threads ? threads : defaultThreads();
+  }
+
   /** \brief Sensor pose in the cloud frame, overriding the cloud's sensor_origin_ /
    * sensor_orientation_. The sensor looks along its +z axis. */
   void setSensorPose(const Eigen::Affine3f& sensor_to_cloud)
@@ -116,6 +132,20 @@ protected:
   /** \brief Stage 1: angles of every input point in indices_, and the vertex map. */
   void projectAndMergeVertices(SphericalTriangulation& result) const;
 
+  /** \brief One vertex per run of equal angle keys in \a sorted. */
+  void
+  mergeEqualAngles(const std::vector<std::pair<std::uint64_t, pcl::index_t>>& sorted,
+                   const Eigen::Affine3d& pose,
+                   SphericalTriangulation& result) const;
+
+  /** \brief Whether point a represents a shared vertex rather than point b. */
+  bool isCloserRepresentative(const Eigen::Affine3d& pose,
+                              pcl::index_t a,
+                              pcl::index_t b) const;
+
+  /** \brief A point in the sensor frame, in double precision. */
+  Eigen::Vector3d toSensorFrame(const Eigen::Affine3d& pose, pcl::index_t index) const;
+
   /** \brief Triangulate the vertices of triangulation_ (stage 2). */
   bool triangulateVertices();
 
@@ -128,6 +158,7 @@ private:
   Eigen::Affine3f sensor_pose_ = Eigen::Affine3f::Identity();
   bool has_sensor_pose_ = false;
   SphericalTriangulation triangulation_;
+  unsigned int num_threads_ = defaultThreads();
 };
 
 } // namespace selective_seg

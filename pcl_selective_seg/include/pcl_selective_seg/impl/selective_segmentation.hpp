@@ -66,6 +66,7 @@ SelectiveSegmentation<PointT>::triangulate()
   delaunay_.setIndices(indices_);
   delaunay_.setBackend(params_.delaunay_backend);
   delaunay_.setAngleQuantization(params_.angle_quantization);
+  delaunay_.setNumberOfThreads(static_cast<unsigned int>(params_.num_threads));
   if (!delaunay_.triangulate())
     return fail("extract", "the spherical triangulation failed (reason above)");
   const SphericalTriangulation& tri = delaunay_.getTriangulation();

@@ -19,21 +19,27 @@ namespace pcl {
 namespace selective_seg {
 namespace detail {
 
-/** \brief A point's place in the vertex map, sortable into a deterministic order. */
-struct ProjectedPoint {
-  QuantizedPoint angles;
-  double range_squared;
-  Eigen::Vector3f xyz;
-  Eigen::Vector3f sensor_xyz;
-  pcl::index_t index;
+/** \brief Sort key of a quantized angle pair: (theta, phi) lexicographic order. */
+inline std::uint64_t
+angleKey(const QuantizedPoint& q)
+{
+  const auto biased = [](std::int32_t v) {
+    return static_cast<std::uint64_t>(static_cast<std::uint32_t>(v) ^ 0x80000000u);
+  };
+  return (biased(q[0]) << 32) | biased(q[1]);
+}
 
-  bool operator<(const ProjectedPoint& o) const
-  {
-    return std::tie(angles, range_squared, xyz.x(), xyz.y(), xyz.z(), index) <
-           std::tie(
-               o.angles, o.range_squared, o.xyz.x(), o.xyz.y(), o.xyz.z(), o.index);
-  }
-};
+inline QuantizedPoint
+keyAngles(std::uint64_t key)
+{
+  const auto unbiased = [](std::uint64_t v) {
+    return static_cast<std::int32_t>(static_cast<std::uint32_t>(v) ^ 0x80000000u);
+  };
+  return {unbiased(key >> 32), unbiased(key & 0xffffffffu)};
+}
+
+/** \brief Key of an excluded point (sorts last); its index then holds the status. */
+constexpr std::uint64_t kExcludedKey = ~std::uint64_t(0);
 
 } // namespace detail
 
@@ -50,56 +56,102 @@ SphericalDelaunay<PointT>::getSensorPose() const
 }
 
 template <typename PointT>
+Eigen::Vector3d
+SphericalDelaunay<PointT>::toSensorFrame(const Eigen::Affine3d& pose,
+                                         pcl::index_t index) const
+{
+  return pose.linear().transpose() *
+         ((*this->input_)[index].getVector3fMap().template cast<double>() -
+          pose.translation());
+}
+
+template <typename PointT>
 void
 SphericalDelaunay<PointT>::projectAndMergeVertices(SphericalTriangulation& result) const
 {
   const auto& cloud = *this->input_;
-  result.point_vertex.assign(cloud.size(), kOutsideIndices);
-  result.angle_quantization = angle_quantization_;
+  const auto& indices = *this->indices_;
   const Eigen::Affine3d pose = getSensorPose().template cast<double>();
-  const Eigen::Matrix3d to_sensor = pose.linear().transpose();
-  const Eigen::Vector3d origin = pose.translation();
-
-  std::vector<detail::ProjectedPoint> projected;
-  projected.reserve(this->indices_->size());
-  for (const auto i : *this->indices_) {
-    const PointT& p = cloud[i];
-    if (!pcl::isXYZFinite(p)) {
-      result.point_vertex[i] = kNonFinite;
+  // (angle key, point index), one per index; computed in parallel, point by point.
+  std::vector<std::pair<std::uint64_t, pcl::index_t>> keyed(indices.size());
+#pragma omp parallel for num_threads(num_threads_) schedule(static)
+  for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(indices.size()); ++k) {
+    const pcl::index_t i = indices[k];
+    keyed[k] = {detail::kExcludedKey, kNonFinite};
+    if (!pcl::isXYZFinite(cloud[i]))
       continue;
-    }
-    const Eigen::Vector3d s =
-        to_sensor * (p.getVector3fMap().template cast<double>() - origin);
-    if (!(s.z() > 0.0)) {
-      result.point_vertex[i] = kBehindSensor;
+    const Eigen::Vector3d s = toSensorFrame(pose, i);
+    keyed[k].second = kBehindSensor;
+    if (!(s.z() > 0.0))
       continue;
-    }
     // eq. 1; both angles lie in (-pi/2, pi/2) because z > 0.
     const QuantizedPoint q{static_cast<std::int32_t>(std::lround(
                                std::atan2(s.x(), s.z()) / angle_quantization_)),
                            static_cast<std::int32_t>(std::lround(
                                std::atan2(s.y(), s.z()) / angle_quantization_))};
-    projected.push_back({q, s.squaredNorm(), p.getVector3fMap(), s.cast<float>(), i});
+    keyed[k] = {detail::angleKey(q), i};
   }
-  std::sort(projected.begin(), projected.end());
-
-  result.vertex_point.clear();
-  result.vertex_angles.clear();
-  result.vertex_positions.clear();
-  for (std::size_t k = 0; k < projected.size(); ++k) {
-    if (k == 0 || projected[k].angles != projected[k - 1].angles) {
-      result.vertex_point.push_back(projected[k].index);
-      result.vertex_angles.push_back(projected[k].angles);
-      result.vertex_positions.push_back(projected[k].sensor_xyz);
-    }
-    result.point_vertex[projected[k].index] =
-        static_cast<pcl::index_t>(result.vertex_point.size() - 1);
-  }
+  result.point_vertex.assign(cloud.size(), kOutsideIndices);
+  result.angle_quantization = angle_quantization_;
+  for (std::size_t k = 0; k < keyed.size(); ++k)
+    if (keyed[k].first == detail::kExcludedKey)
+      result.point_vertex[indices[k]] = keyed[k].second;
+  keyed.erase(std::remove_if(keyed.begin(),
+                             keyed.end(),
+                             [](const std::pair<std::uint64_t, pcl::index_t>& e) {
+                               return e.first == detail::kExcludedKey;
+                             }),
+              keyed.end());
+  std::sort(keyed.begin(), keyed.end());
+  mergeEqualAngles(keyed, pose, result);
   for (const auto v : result.point_vertex) {
     result.num_outside_indices += (v == kOutsideIndices);
     result.num_non_finite += (v == kNonFinite);
     result.num_behind_sensor += (v == kBehindSensor);
   }
+}
+
+template <typename PointT>
+void
+SphericalDelaunay<PointT>::mergeEqualAngles(
+    const std::vector<std::pair<std::uint64_t, pcl::index_t>>& sorted,
+    const Eigen::Affine3d& pose,
+    SphericalTriangulation& result) const
+{
+  result.vertex_point.clear();
+  result.vertex_angles.clear();
+  result.vertex_positions.clear();
+  for (std::size_t begin = 0; begin < sorted.size();) {
+    std::size_t end = begin + 1;
+    while (end < sorted.size() && sorted[end].first == sorted[begin].first)
+      ++end;
+    // The representative: nearest to the sensor, ties by x, y, z, then index; the
+    // choice depends on the points only, not on their order.
+    pcl::index_t best = sorted[begin].second;
+    for (std::size_t k = begin + 1; k < end; ++k)
+      if (isCloserRepresentative(pose, sorted[k].second, best))
+        best = sorted[k].second;
+    const auto vertex = static_cast<pcl::index_t>(result.vertex_point.size());
+    result.vertex_point.push_back(best);
+    result.vertex_angles.push_back(detail::keyAngles(sorted[begin].first));
+    result.vertex_positions.push_back(toSensorFrame(pose, best).template cast<float>());
+    for (std::size_t k = begin; k < end; ++k)
+      result.point_vertex[sorted[k].second] = vertex;
+    begin = end;
+  }
+}
+
+template <typename PointT>
+bool
+SphericalDelaunay<PointT>::isCloserRepresentative(const Eigen::Affine3d& pose,
+                                                  pcl::index_t a,
+                                                  pcl::index_t b) const
+{
+  const auto& pa = (*this->input_)[a];
+  const auto& pb = (*this->input_)[b];
+  const double ra = toSensorFrame(pose, a).squaredNorm();
+  const double rb = toSensorFrame(pose, b).squaredNorm();
+  return std::tie(ra, pa.x, pa.y, pa.z, a) < std::tie(rb, pb.x, pb.y, pb.z, b);
 }
 
 template <typename PointT>
