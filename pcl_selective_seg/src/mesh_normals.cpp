@@ -6,6 +6,7 @@
 
 #include <pcl_selective_seg/mesh_normals.h>
 #include <pcl_selective_seg/region_merging.h>
+#include <pcl_selective_seg/spherical_delaunay.h>
 
 #include <algorithm>
 #include <cmath>
@@ -15,6 +16,13 @@ namespace pcl {
 namespace selective_seg {
 
 namespace {
+
+/** OpenMP thread count: 0 = all cores. */
+int
+threads(int requested)
+{
+  return requested > 0 ? requested : static_cast<int>(defaultThreads());
+}
 
 /** The weight of a triangle in eq. 2, or 0 when it is degenerate. */
 double
@@ -42,13 +50,16 @@ computeTriangleNormals(const Vector3fVector& positions,
                        const std::vector<Triangle>& triangles,
                        const Eigen::Vector3f& viewpoint,
                        Vector3fVector& normals,
-                       std::vector<double>& areas)
+                       std::vector<double>& areas,
+                       int num_threads)
 {
   const float nan = std::numeric_limits<float>::quiet_NaN();
   normals.assign(triangles.size(), Eigen::Vector3f::Constant(nan));
   areas.assign(triangles.size(), 0.0);
   const Eigen::Vector3d eye = viewpoint.cast<double>();
-  for (std::size_t t = 0; t < triangles.size(); ++t) {
+  const auto n_tri = static_cast<std::ptrdiff_t>(triangles.size());
+#pragma omp parallel for num_threads(threads(num_threads)) schedule(static)
+  for (std::ptrdiff_t t = 0; t < n_tri; ++t) {
     const Eigen::Vector3d a = positions[triangles[t][0]].cast<double>();
     const Eigen::Vector3d b = positions[triangles[t][1]].cast<double>();
     const Eigen::Vector3d c = positions[triangles[t][2]].cast<double>();
@@ -70,22 +81,27 @@ computeVertexNormals(std::size_t num_vertices,
                      const Vector3fVector& normals,
                      const std::vector<double>& areas,
                      Vector3fVector& vertex_normals,
-                     std::vector<double>& vertex_areas)
+                     std::vector<double>& vertex_areas,
+                     int num_threads)
 {
-  std::vector<Eigen::Vector3d> sums(num_vertices, Eigen::Vector3d::Zero());
+  // Gathered per vertex over its triangles in increasing order: the same sums, in the
+  // same order, whatever the number of threads.
+  const Incidence incident = vertexTriangles(triangles, num_vertices);
   vertex_areas.assign(num_vertices, 0.0);
-  for (std::size_t t = 0; t < triangles.size(); ++t) {
-    const double weight = normalWeight(areas[t], normals[t]); // eq. 2
-    for (const auto v : triangles[t]) {
-      if (std::isfinite(areas[t]))
-        vertex_areas[v] += areas[t]; // eq. 3
-      if (weight > 0.0)              // degenerate triangles are skipped (NaN normals)
-        sums[v] += weight * normals[t].cast<double>();
-    }
-  }
   vertex_normals.resize(num_vertices);
-  for (std::size_t v = 0; v < num_vertices; ++v)
-    vertex_normals[v] = normalizedOrNaN(sums[v]);
+#pragma omp parallel for num_threads(threads(num_threads)) schedule(static)
+  for (std::ptrdiff_t v = 0; v < static_cast<std::ptrdiff_t>(num_vertices); ++v) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (auto i = incident.offsets[v]; i < incident.offsets[v + 1]; ++i) {
+      const auto t = incident.items[i];
+      if (std::isfinite(areas[t]))
+        vertex_areas[v] += areas[t];                            // eq. 3
+      const double weight = normalWeight(areas[t], normals[t]); // eq. 2
+      if (weight > 0.0) // degenerate triangles are skipped (NaN normals)
+        sum += weight * normals[t].cast<double>();
+    }
+    vertex_normals[v] = normalizedOrNaN(sum);
+  }
 }
 
 void
@@ -154,12 +170,15 @@ markEdgeOnTriangles(const Vector3fVector& positions,
                     const Vector3fVector& normals,
                     const Eigen::Vector3f& viewpoint,
                     double max_incidence,
-                    std::vector<std::uint8_t>& edge_on)
+                    std::vector<std::uint8_t>& edge_on,
+                    int num_threads)
 {
   edge_on.assign(triangles.size(), 0);
   const double min_cos = max_incidence >= M_PI / 2.0 ? 0.0 : std::cos(max_incidence);
   const Eigen::Vector3d eye = viewpoint.cast<double>();
-  for (std::size_t t = 0; t < triangles.size(); ++t) {
+  const auto n_tri = static_cast<std::ptrdiff_t>(triangles.size());
+#pragma omp parallel for num_threads(threads(num_threads)) schedule(static)
+  for (std::ptrdiff_t t = 0; t < n_tri; ++t) {
     if (!normals[t].allFinite()) {
       edge_on[t] = 1;
       continue;
@@ -179,13 +198,18 @@ medianEdgeLength(const Vector3fVector& positions,
 {
   if (triangles.empty())
     return 0.0;
+  // Large meshes: every stride-th triangle (a fixed function of the canonical triangle
+  // order) still gives over 300,000 edges, plenty for a median.
+  const std::size_t stride = std::max<std::size_t>(1, triangles.size() / 100000);
   std::vector<double> lengths;
-  lengths.reserve(3 * triangles.size());
-  for (const auto& t : triangles)
+  lengths.reserve(3 * (triangles.size() / stride + 1));
+  for (std::size_t k = 0; k < triangles.size(); k += stride) {
+    const Triangle& t = triangles[k];
     for (int i = 0; i < 3; ++i)
       lengths.push_back(
           (positions[t[i]].cast<double>() - positions[t[(i + 1) % 3]].cast<double>())
               .norm());
+  }
   auto middle = lengths.begin() + static_cast<std::ptrdiff_t>(lengths.size() / 2);
   std::nth_element(lengths.begin(), middle, lengths.end());
   return *middle;

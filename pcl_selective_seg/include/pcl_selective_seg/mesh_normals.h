@@ -34,7 +34,8 @@ PCL_EXPORTS void computeTriangleNormals(const Vector3fVector& positions,
                                         const std::vector<Triangle>& triangles,
                                         const Eigen::Vector3f& viewpoint,
                                         Vector3fVector& normals,
-                                        std::vector<double>& areas);
+                                        std::vector<double>& areas,
+                                        int num_threads = 0);
 
 /** \brief Point normals (eq. 2) and point areas (eq. 3).
  *
@@ -48,13 +49,16 @@ PCL_EXPORTS void computeTriangleNormals(const Vector3fVector& positions,
  * \param[out] vertex_normals #V unit normals; NaN where no valid triangle is incident
  *             or the weighted normals cancel
  * \param[out] vertex_areas #V areas A_p [m^2]
+ * \param[in] num_threads OpenMP threads, 0 = all cores (the result does not depend on
+ * it)
  */
 PCL_EXPORTS void computeVertexNormals(std::size_t num_vertices,
                                       const std::vector<Triangle>& triangles,
                                       const Vector3fVector& normals,
                                       const std::vector<double>& areas,
                                       Vector3fVector& vertex_normals,
-                                      std::vector<double>& vertex_areas);
+                                      std::vector<double>& vertex_areas,
+                                      int num_threads = 0);
 
 /** \brief Point normals over a wider neighbourhood: eq. 2 summed over the triangles of
  * the k-ring of each vertex instead of its one ring.
@@ -97,13 +101,15 @@ computeTriangleNormalsFromVertices(const std::vector<Triangle>& triangles,
  * \param[in] viewpoint sensor origin [m]
  * \param[in] max_incidence [rad]; pi/2 or more flags only degenerate triangles
  * \param[out] edge_on #T 1 = seen edge-on
+ * \param[in] num_threads OpenMP threads, 0 = all cores
  */
 PCL_EXPORTS void markEdgeOnTriangles(const Vector3fVector& positions,
                                      const std::vector<Triangle>& triangles,
                                      const Vector3fVector& normals,
                                      const Eigen::Vector3f& viewpoint,
                                      double max_incidence,
-                                     std::vector<std::uint8_t>& edge_on);
+                                     std::vector<std::uint8_t>& edge_on,
+                                     int num_threads = 0);
 
 /** \brief Median 3-D length of the triangles' edges [m] (each interior edge counted
  * twice); 0 for an empty mesh. The octree's automatic minimum voxel size scales it. */
