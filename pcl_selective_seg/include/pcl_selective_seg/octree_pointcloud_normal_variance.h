@@ -12,7 +12,9 @@
 #include <pcl/octree/octree_pointcloud.h>
 #include <pcl/point_types.h>
 
+#include <algorithm>
 #include <memory>
+#include <thread>
 #include <vector>
 
 namespace pcl {
@@ -71,6 +73,14 @@ public:
    * by addPointsFromInputCloud(). */
   void setInputNormals(const NormalCloudConstPtr& normals, const AreasConstPtr& areas);
 
+  /** \brief Threads for the per-point work (0: all cores); the result does not
+   * depend on it. */
+  void setNumberOfThreads(unsigned int threads)
+  {
+    num_threads_ =
+        threads ? threads : std::max(1u, std::thread::hardware_concurrency());
+  }
+
   /** \brief Orientation of the sensor in the cloud frame (the angles of eq. 5 are
    * measured in the sensor frame). Default: identity. */
   void setSensorOrientation(const Eigen::Quaternionf& orientation)
@@ -113,8 +123,11 @@ protected:
 
   bool isValidPoint(pcl::index_t index) const;
 
-  /** \brief Order the points depth first; cache their normal angles. */
+  /** \brief Order the points depth first. */
   void orderPoints(const pcl::octree::OctreeNode* node);
+
+  /** \brief Normals, angles and areas of the ordered points (in parallel). */
+  void computeNormalAngles();
 
   /** \brief eq. 4-6 over ordered points [begin, end). */
   NodeStatistics computeStatistics(std::size_t begin, std::size_t end) const;
@@ -139,6 +152,7 @@ private:
   std::vector<double> ordered_phi_;
   std::vector<double> ordered_areas_; ///< A_p
   std::vector<AdaptiveLeaf> leaves_;
+  unsigned int num_threads_ = std::max(1u, std::thread::hardware_concurrency());
 };
 
 } // namespace selective_seg

@@ -104,24 +104,40 @@ OctreePointCloudNormalVariance<PointT>::orderPoints(const pcl::octree::OctreeNod
     auto& container =
         const_cast<LeafNode*>(static_cast<const LeafNode*>(node))->getContainer();
     container.setFirstOrderedPoint(ordered_indices_.size());
-    const Eigen::Matrix3d to_sensor =
-        sensor_orientation_.toRotationMatrix().transpose().template cast<double>();
-    for (const auto i : container.getPointIndicesVector()) {
-      const Eigen::Vector3d m =
-          -(to_sensor * (*normals_)[i].getNormalVector3fMap().template cast<double>())
-               .normalized();
-      ordered_indices_.push_back(i);
-      ordered_normals_.push_back(m);
-      ordered_theta_.push_back(std::atan2(m.x(), m.z()));
-      ordered_phi_.push_back(std::atan2(m.y(), m.z()));
-      ordered_areas_.push_back((*areas_)[i]);
-    }
+    const auto& indices = container.getPointIndicesVector();
+    ordered_indices_.insert(ordered_indices_.end(), indices.begin(), indices.end());
     return;
   }
   const auto* branch = static_cast<const BranchNode*>(node);
   for (unsigned char c = 0; c < 8; ++c)
     if (const auto* child = branch->getChildPtr(c))
       orderPoints(child);
+}
+
+template <typename PointT>
+void
+OctreePointCloudNormalVariance<PointT>::computeNormalAngles()
+{
+  const std::size_t n = ordered_indices_.size();
+  ordered_normals_.resize(n);
+  ordered_theta_.resize(n);
+  ordered_phi_.resize(n);
+  ordered_areas_.resize(n);
+  const Eigen::Matrix3d to_sensor =
+      sensor_orientation_.toRotationMatrix().transpose().template cast<double>();
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(num_threads_) schedule(static)
+#endif
+  for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(n); ++k) {
+    const auto i = ordered_indices_[k];
+    const Eigen::Vector3d m =
+        -(to_sensor * (*normals_)[i].getNormalVector3fMap().template cast<double>())
+             .normalized();
+    ordered_normals_[k] = m;
+    ordered_theta_[k] = std::atan2(m.x(), m.z());
+    ordered_phi_[k] = std::atan2(m.y(), m.z());
+    ordered_areas_[k] = (*areas_)[i];
+  }
 }
 
 template <typename PointT>
@@ -234,6 +250,7 @@ OctreePointCloudNormalVariance<PointT>::computeAdaptiveLeaves(
   ordered_indices_.reserve(this->indices_ ? this->indices_->size()
                                           : this->input_->size());
   orderPoints(this->root_node_);
+  computeNormalAngles();
   splitOrKeep(this->root_node_,
               pcl::octree::OctreeKey(),
               0,

@@ -182,6 +182,7 @@ SelectiveSegmentation<PointT>::buildOctree()
   octree_ = pcl::make_shared<Octree>(resolution);
   octree_->setInputCloud(vertices);
   octree_->setInputNormals(normals, vertex_areas_);
+  octree_->setNumberOfThreads(static_cast<unsigned int>(params_.num_threads));
   if (!octree_->addPointsFromInputCloud())
     return fail("extract", "no point with a normal to insert into the octree");
   octree_->computeAdaptiveLeaves(params_.max_normal_std_dev,

@@ -74,7 +74,9 @@ SphericalDelaunay<PointT>::projectAndMergeVertices(SphericalTriangulation& resul
   const Eigen::Affine3d pose = getSensorPose().template cast<double>();
   // (angle key, point index), one per index; computed in parallel, point by point.
   std::vector<std::pair<std::uint64_t, pcl::index_t>> keyed(indices.size());
+#ifdef _OPENMP
 #pragma omp parallel for num_threads(num_threads_) schedule(static)
+#endif
   for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(indices.size()); ++k) {
     const pcl::index_t i = indices[k];
     keyed[k] = {detail::kExcludedKey, kNonFinite};
