@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Regenerate docs/performance.md and docs/images/performance_scaling.png: the Google
+# Benchmark suite (this pipeline per stage and pcl::NormalEstimation +
+# pcl::RegionGrowing on the same clouds), and the peak memory of the command-line tool.
+#
+# Usage: apps/run_benchmarks.sh BUILD_DIR [SHARED_DATA_DIR]
+# Needs python3 (standard library only) and gnuplot for the plot.
+set -euo pipefail
+build=${1:?usage: $0 BUILD_DIR [SHARED_DATA_DIR]}
+shared=${2:-$(dirname "$0")/../../shared/data}
+repo=$(cd "$(dirname "$0")/.." && pwd)
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+
+SELSEG_DATA="$shared" "$build/test/selseg_benchmark" \
+  --benchmark_out="$work/benchmark.json" --benchmark_out_format=json
+
+# Peak memory of the command-line tool on the same simulated door scans.
+for n in 10000 46255 300000 1000000 3000000; do
+  density=$(python3 -c "print($n / 46140)")
+  "$build/apps/pcl_selective_seg_simulate" -scene door -density "$density" \
+    -density_ratio 10 -o "$work/door_$n.pcd" > /dev/null
+done
+python3 "$repo/apps/perf_report.py" --benchmark "$work/benchmark.json" \
+  --tool "$build/apps/pcl_selective_seg" --scans "$work" \
+  --markdown "$repo/docs/performance.md" --plot "$repo/docs/images/performance_scaling.png"
