@@ -20,6 +20,19 @@ namespace pcl {
 namespace selective_seg {
 namespace detail {
 
+/** \brief Depth-first position of a finest voxel: the bits of its key interleaved as
+ * PCL numbers the children (x, y, z from the most significant). */
+inline std::uint64_t
+mortonCode(const pcl::octree::OctreeKey& key)
+{
+  std::uint64_t code = 0;
+  for (unsigned b = 0; b < 21; ++b)
+    code |= (std::uint64_t((key.x >> b) & 1u) << (3 * b + 2)) |
+            (std::uint64_t((key.y >> b) & 1u) << (3 * b + 1)) |
+            (std::uint64_t((key.z >> b) & 1u) << (3 * b));
+  return code;
+}
+
 /** \brief Angle difference wrapped into (-pi, pi]. */
 inline double
 wrapAngle(double a)
@@ -91,8 +104,20 @@ OctreePointCloudNormalVariance<PointT>::addPointsFromInputCloud()
   // Pad the top so that no point sits exactly on the box's upper faces.
   hi += 0.01 * this->resolution_;
   this->defineBoundingBox(lo.x(), lo.y(), lo.z(), hi.x(), hi.y(), hi.z());
-  for (const auto i : valid)
-    this->addPointIdx(i);
+  // Insert in depth-first (Morton) order of the finest voxels: the tree is walked with
+  // locality, and every leaf receives its points in increasing index order.
+  std::vector<std::pair<std::uint64_t, pcl::index_t>> order(valid.size());
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(num_threads_) schedule(static)
+#endif
+  for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(valid.size()); ++k) {
+    pcl::octree::OctreeKey key;
+    this->genOctreeKeyforPoint((*this->input_)[valid[k]], key);
+    order[k] = {detail::mortonCode(key), valid[k]};
+  }
+  std::sort(order.begin(), order.end());
+  for (const auto& entry : order)
+    this->addPointIdx(entry.second);
   return true;
 }
 
