@@ -436,7 +436,9 @@ circumcircleInsideBox(const Points& points,
 
 /** Triangulates a shuffled copy and maps the ids back to \a points. */
 Triangles
-triangulatePermuted(const Points& points, std::mt19937& rng)
+triangulatePermuted(const Points& points,
+                    std::mt19937& rng,
+                    DelaunayBackend backend = DelaunayBackend::BoostVoronoi)
 {
   std::vector<index_t> order(points.size());
   std::iota(order.begin(), order.end(), 0);
@@ -444,7 +446,7 @@ triangulatePermuted(const Points& points, std::mt19937& rng)
   Points shuffled(points.size());
   for (std::size_t k = 0; k < points.size(); ++k)
     shuffled[k] = points[order[k]];
-  Triangles triangles = triangulate(shuffled);
+  Triangles triangles = triangulate(shuffled, backend);
   for (auto& t : triangles)
     for (auto& v : t)
       v = order[v];
@@ -465,33 +467,136 @@ bruteForceNeighbours(const Triangles& triangles)
   return neighbours;
 }
 
+/** A depth camera's pixel grid in (theta, phi): cols x rows points step apart, each
+ * moved by up to x_jitter and y_jitter (x jitter of a unit or two splits a column into
+ * interleaved sub-columns, as float rounding does in real scans), pixels dropped at
+ * random and, if \a holes, in a few discs (missing depth); sorted like the vertices of
+ * SphericalDelaunay. */
+Points
+depthImagePoints(int cols,
+                 int rows,
+                 std::int32_t step,
+                 std::int32_t x_jitter,
+                 std::int32_t y_jitter,
+                 bool holes,
+                 std::mt19937& rng)
+{
+  std::uniform_int_distribution<std::int32_t> dx(-x_jitter, x_jitter),
+      dy(-y_jitter, y_jitter);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const auto in_hole = [&](int i, int j) {
+    const double u = static_cast<double>(i) / cols, v = static_cast<double>(j) / rows;
+    return holes && (std::hypot(u - 0.3, v - 0.6) < 0.08 ||
+                     std::hypot(u - 0.7, v - 0.3) < 0.05 ||
+                     (u > 0.95 && v > 0.5 + 10 * (1 - u)));
+  };
+  Points points;
+  for (int i = 0; i < cols; ++i)
+    for (int j = 0; j < rows; ++j)
+      if (!in_hole(i, j) && unit(rng) > (holes ? 0.02 : 0.0))
+        points.push_back({-step * cols / 2 + i * step + dx(rng),
+                          -step * rows / 2 + j * step + dy(rng)});
+  std::sort(points.begin(), points.end());
+  points.erase(std::unique(points.begin(), points.end()), points.end());
+  return points;
+}
+
+/** Whether the sweep gives Boost's triangles exactly. */
+::testing::AssertionResult
+sweepMatchesBoost(const Points& points)
+{
+  const Triangles boost = triangulate(points, DelaunayBackend::BoostVoronoi);
+  const Triangles sweep = triangulate(points, DelaunayBackend::Sweep);
+  if (sweep == boost)
+    return ::testing::AssertionSuccess();
+  const auto differ =
+      std::mismatch(boost.begin(), boost.end(), sweep.begin(), sweep.end());
+  return ::testing::AssertionFailure()
+         << points.size() << " points: " << boost.size() << " triangles from boost, "
+         << sweep.size() << " from the sweep, first difference at position "
+         << (differ.first - boost.begin());
+}
+
 } // namespace
 
 TEST(DelaunayBackend, NamesAndAvailability)
 {
   EXPECT_STREQ(pcl::selective_seg::toString(DelaunayBackend::BoostVoronoi), "boost");
   EXPECT_STREQ(pcl::selective_seg::toString(DelaunayBackend::Vtk), "vtk");
+  EXPECT_STREQ(pcl::selective_seg::toString(DelaunayBackend::Sweep), "sweep");
   EXPECT_TRUE(isDelaunayBackendAvailable(DelaunayBackend::BoostVoronoi));
+  EXPECT_TRUE(isDelaunayBackendAvailable(DelaunayBackend::Sweep));
   EXPECT_FALSE(isDelaunayBackendAvailable(static_cast<DelaunayBackend>(7)));
 }
 
-TEST(Delaunay2D, ThreePointsGiveOneCounterClockwiseTriangle)
+TEST(DelaunayBackend, UnavailableBackendFails)
+{
+  std::vector<DelaunayBackend> unavailable{static_cast<DelaunayBackend>(7)};
+  if (!isDelaunayBackendAvailable(DelaunayBackend::Vtk))
+    unavailable.push_back(DelaunayBackend::Vtk);
+  const Points points{{0, 0}, {5, 0}, {0, 5}};
+  for (const auto backend : unavailable) {
+    Triangles triangles{{0, 1, 2}};
+    std::string error;
+    EXPECT_FALSE(delaunay2d(points, backend, triangles, &error));
+    EXPECT_TRUE(triangles.empty());
+    EXPECT_NE(error.find("not available"), std::string::npos) << error;
+  }
+}
+
+TEST(DelaunayBackend, DuplicatePointsAreRejectedWithOneMessage)
+{
+  // Sorted input too: the sweep checks sorted input separately.
+  for (const Points& points : {Points{{0, 0}, {5, 0}, {0, 5}, {3, 3}, {5, 0}},
+                               Points{{0, 0}, {0, 5}, {3, 3}, {5, 0}, {5, 0}}}) {
+    std::string boost_error;
+    for (const auto backend : {DelaunayBackend::BoostVoronoi,
+                               DelaunayBackend::Sweep,
+                               DelaunayBackend::Vtk}) {
+      if (!isDelaunayBackendAvailable(backend))
+        continue;
+      Triangles triangles{{0, 1, 2}};
+      std::string error;
+      EXPECT_FALSE(delaunay2d(points, backend, triangles, &error));
+      EXPECT_TRUE(triangles.empty());
+      EXPECT_NE(error.find("duplicate"), std::string::npos) << error;
+      if (backend == DelaunayBackend::BoostVoronoi)
+        boost_error = error;
+      if (backend == DelaunayBackend::Sweep) {
+        EXPECT_EQ(error, boost_error);
+      }
+    }
+  }
+}
+
+/** The exact backends: every exactness test runs on each of them. */
+class Delaunay2D : public ::testing::TestWithParam<DelaunayBackend> {};
+
+INSTANTIATE_TEST_SUITE_P(Exact,
+                         Delaunay2D,
+                         ::testing::Values(DelaunayBackend::BoostVoronoi,
+                                           DelaunayBackend::Sweep),
+                         [](const ::testing::TestParamInfo<DelaunayBackend>& info) {
+                           return std::string(pcl::selective_seg::toString(info.param));
+                         });
+
+TEST_P(Delaunay2D, ThreePointsGiveOneCounterClockwiseTriangle)
 {
   // Given clockwise: (0, 0), (0, 10), (10, 0).
   const Points points{{0, 0}, {0, 10}, {10, 0}};
-  EXPECT_EQ(triangulate(points), (Triangles{{0, 2, 1}}));
+  EXPECT_EQ(triangulate(points, GetParam()), (Triangles{{0, 2, 1}}));
 }
 
-TEST(Delaunay2D, SquareIsSplitByTheFanFromItsSmallestPoint)
+TEST_P(Delaunay2D, SquareIsSplitByTheFanFromItsSmallestPoint)
 {
   // The smallest point (0, 0) is id 1, so the diagonal is 1 - 0, not 2 - 3.
   const Points points{{1, 1}, {0, 0}, {1, 0}, {0, 1}};
-  const Triangles triangles = triangulate(points);
+  const Triangles triangles = triangulate(points, GetParam());
   EXPECT_EQ(triangles, (Triangles{{0, 1, 2}, {0, 3, 1}}));
   EXPECT_TRUE(isCanonicalDelaunay(points, triangles));
 }
 
-TEST(Delaunay2D, CoCircularQuadrilateralsFollowTheFanInEveryInputOrder)
+TEST_P(Delaunay2D, CoCircularQuadrilateralsFollowTheFanInEveryInputOrder)
 {
   // Corners counter-clockwise from the smallest one: the fan is (0, 1, 2), (0, 2, 3).
   const std::vector<Points> shapes{{{0, 0}, {2, 0}, {2, 1}, {0, 1}},
@@ -506,19 +611,19 @@ TEST(Delaunay2D, CoCircularQuadrilateralsFollowTheFanInEveryInputOrder)
         points[k] = corners[order[k]];
         id[order[k]] = k;
       }
-      EXPECT_EQ(triangulate(points),
+      EXPECT_EQ(triangulate(points, GetParam()),
                 canonical({{id[0], id[1], id[2]}, {id[0], id[2], id[3]}}));
     } while (std::next_permutation(order.begin(), order.end()));
   }
 }
 
-TEST(Delaunay2D, RegularGridFollowsTheCanonicalDiagonals)
+TEST_P(Delaunay2D, RegularGridFollowsTheCanonicalDiagonals)
 {
   // 5 x 10 grid of 7 x 5 rectangles (each co-circular), id i * 10 + j at column i, row
   // j. The smallest corner of a cell is its lower left one: every diagonal starts
   // there.
   const Points points = gridPoints(5, 10, -20, -30, 7, 5);
-  const Triangles triangles = triangulate(points);
+  const Triangles triangles = triangulate(points, GetParam());
   ASSERT_EQ(triangles.size(), 2u * (5 - 1) * (10 - 1));
   Triangles expected;
   for (index_t i = 0; i + 1 < 5; ++i) {
@@ -541,45 +646,31 @@ TEST(Delaunay2D, RegularGridFollowsTheCanonicalDiagonals)
   const std::int32_t step = 1 << 23;
   const Points wide =
       gridPoints(5, 10, -4 * step + 3, -9 * (step / 2) - 1, 2 * step, step);
-  EXPECT_EQ(triangulate(wide), triangles);
+  EXPECT_EQ(triangulate(wide, GetParam()), triangles);
 }
 
-TEST(Delaunay2D, CollinearPointsGiveNoTriangles)
+TEST_P(Delaunay2D, CollinearPointsGiveNoTriangles)
 {
   Points points;
   for (std::int32_t k : {5, -3, 0, 11, 2, -9})
     points.push_back({100 + 3 * k, -50 - 2 * k});
   Triangles triangles{{0, 1, 2}};
   std::string error;
-  EXPECT_TRUE(delaunay2d(points, DelaunayBackend::BoostVoronoi, triangles, &error));
+  EXPECT_TRUE(delaunay2d(points, GetParam(), triangles, &error));
   EXPECT_TRUE(triangles.empty());
   EXPECT_TRUE(error.empty());
 }
 
-TEST(Delaunay2D, FewerThanThreePointsGiveNoTriangles)
+TEST_P(Delaunay2D, FewerThanThreePointsGiveNoTriangles)
 {
   for (const Points& points : {Points{}, Points{{1, 2}}, Points{{1, 2}, {3, 4}}}) {
     Triangles triangles{{0, 1, 2}};
-    EXPECT_TRUE(delaunay2d(points, DelaunayBackend::BoostVoronoi, triangles));
+    EXPECT_TRUE(delaunay2d(points, GetParam(), triangles));
     EXPECT_TRUE(triangles.empty());
   }
 }
 
-TEST(Delaunay2D, DuplicatePointsAreRejected)
-{
-  const Points points{{0, 0}, {5, 0}, {0, 5}, {3, 3}, {5, 0}};
-  for (const auto backend : {DelaunayBackend::BoostVoronoi, DelaunayBackend::Vtk}) {
-    if (!isDelaunayBackendAvailable(backend))
-      continue;
-    Triangles triangles{{0, 1, 2}};
-    std::string error;
-    EXPECT_FALSE(delaunay2d(points, backend, triangles, &error));
-    EXPECT_TRUE(triangles.empty());
-    EXPECT_NE(error.find("duplicate"), std::string::npos) << error;
-  }
-}
-
-TEST(Delaunay2D, OutOfRangeCoordinatesAreRejected)
+TEST_P(Delaunay2D, OutOfRangeCoordinatesAreRejected)
 {
   const std::int32_t max = kMaxDelaunayCoordinate;
   for (const QuantizedPoint& bad :
@@ -589,67 +680,52 @@ TEST(Delaunay2D, OutOfRangeCoordinatesAreRejected)
     const Points points{{0, 0}, {5, 0}, {0, 5}, bad};
     Triangles triangles{{0, 1, 2}};
     std::string error;
-    EXPECT_FALSE(delaunay2d(points, DelaunayBackend::BoostVoronoi, triangles, &error));
+    EXPECT_FALSE(delaunay2d(points, GetParam(), triangles, &error));
     EXPECT_TRUE(triangles.empty());
     EXPECT_FALSE(error.empty());
   }
   // The limits themselves are accepted.
   const Points corners{{-max, -max}, {max, -max}, {max, max}, {-max, max}, {1, 2}};
-  EXPECT_TRUE(isCanonicalDelaunay(corners, triangulate(corners)));
+  EXPECT_TRUE(isCanonicalDelaunay(corners, triangulate(corners, GetParam())));
 }
 
-TEST(Delaunay2D, UnavailableBackendFails)
-{
-  std::vector<DelaunayBackend> unavailable{static_cast<DelaunayBackend>(7)};
-  if (!isDelaunayBackendAvailable(DelaunayBackend::Vtk))
-    unavailable.push_back(DelaunayBackend::Vtk);
-  const Points points{{0, 0}, {5, 0}, {0, 5}};
-  for (const auto backend : unavailable) {
-    Triangles triangles{{0, 1, 2}};
-    std::string error;
-    EXPECT_FALSE(delaunay2d(points, backend, triangles, &error));
-    EXPECT_TRUE(triangles.empty());
-    EXPECT_NE(error.find("not available"), std::string::npos) << error;
-  }
-}
-
-TEST(Delaunay2D, RandomPointsAreDelaunay)
+TEST_P(Delaunay2D, RandomPointsAreDelaunay)
 {
   std::mt19937 rng(42);
   const Points small_range = uniformPoints(3000, 1000, rng);
-  EXPECT_TRUE(isCanonicalDelaunay(small_range, triangulate(small_range)));
+  EXPECT_TRUE(isCanonicalDelaunay(small_range, triangulate(small_range, GetParam())));
   const Points full_range = uniformPoints(3000, kMaxDelaunayCoordinate, rng);
-  EXPECT_TRUE(isCanonicalDelaunay(full_range, triangulate(full_range)));
+  EXPECT_TRUE(isCanonicalDelaunay(full_range, triangulate(full_range, GetParam())));
   const Points clustered = clusteredPoints(4000, rng);
-  EXPECT_TRUE(isCanonicalDelaunay(clustered, triangulate(clustered)));
+  EXPECT_TRUE(isCanonicalDelaunay(clustered, triangulate(clustered, GetParam())));
 }
 
-TEST(Delaunay2D, SnappedPointsAreDelaunayAndCanonical)
+TEST_P(Delaunay2D, SnappedPointsAreDelaunayAndCanonical)
 {
   std::mt19937 rng(42);
   for (const std::int32_t cells : {20, 45}) {
     const Points points = snappedPoints(2500, cells, 64, rng);
-    const Triangles triangles = triangulate(points);
+    const Triangles triangles = triangulate(points, GetParam());
     EXPECT_TRUE(isCanonicalDelaunay(points, triangles));
     EXPECT_GT(countCoCircularEdges(points, triangles), points.size() / 10);
   }
 }
 
-TEST(Delaunay2D, NearlyCoCircularPointsAreTriangulatedExactly)
+TEST_P(Delaunay2D, NearlyCoCircularPointsAreTriangulatedExactly)
 {
   // Far from the origin, Boost.Polygon merges the circumcentres of these four points
   // (1/(2R) apart, a few ULPs); they are not co-circular, so the triangulation must
   // still be the exact one: the diagonal avoiding the point just outside the circle.
   const std::int32_t c = 1 << 25, r = 9765625; // r = 5^10
   const Points left_moved{{c + r, c}, {c, c - r}, {c - r, c + 1}, {c, c + r}};
-  EXPECT_EQ(triangulate(left_moved), (Triangles{{0, 3, 1}, {1, 3, 2}}));
+  EXPECT_EQ(triangulate(left_moved, GetParam()), (Triangles{{0, 3, 1}, {1, 3, 2}}));
   const Points top_moved{{c + r, c}, {c, c - r}, {c - r, c}, {c + 1, c + r}};
-  EXPECT_EQ(triangulate(top_moved), (Triangles{{0, 2, 1}, {0, 3, 2}}));
+  EXPECT_EQ(triangulate(top_moved, GetParam()), (Triangles{{0, 2, 1}, {0, 3, 2}}));
   const Points on_circle{{c + r, c}, {c, c - r}, {c - r, c}, {c, c + r}};
-  EXPECT_EQ(triangulate(on_circle), (Triangles{{0, 2, 1}, {0, 3, 2}}));
+  EXPECT_EQ(triangulate(on_circle, GetParam()), (Triangles{{0, 2, 1}, {0, 3, 2}}));
 }
 
-TEST(Delaunay2D, CoCircularGroupNextToANearlyCoCircularPointIsAFan)
+TEST_P(Delaunay2D, CoCircularGroupNextToANearlyCoCircularPointIsAFan)
 {
   // Twelve lattice points of one circle, point 2 moved just outside along the tangent.
   // Boost.Polygon merges all of them into one vertex; the eleven co-circular ones must
@@ -667,7 +743,7 @@ TEST(Delaunay2D, CoCircularGroupNextToANearlyCoCircularPointIsAFan)
                       {c - b, c - a},
                       {c + a, c - b},
                       {c + b, c - a}};
-  const Triangles triangles = triangulate(points);
+  const Triangles triangles = triangulate(points, GetParam());
   EXPECT_EQ(triangles,
             (Triangles{{0, 5, 9},
                        {0, 9, 11},
@@ -682,7 +758,7 @@ TEST(Delaunay2D, CoCircularGroupNextToANearlyCoCircularPointIsAFan)
   EXPECT_TRUE(isCanonicalDelaunay(points, triangles));
 }
 
-TEST(Delaunay2D, CoCircularAndNearlyCoCircularStress)
+TEST_P(Delaunay2D, CoCircularAndNearlyCoCircularStress)
 {
   std::mt19937 rng(42);
   const std::int32_t c = 1 << 25;
@@ -706,12 +782,12 @@ TEST(Delaunay2D, CoCircularAndNearlyCoCircularStress)
     }
   }
   points = distinctShuffled(points, rng);
-  const Triangles triangles = triangulate(points);
+  const Triangles triangles = triangulate(points, GetParam());
   EXPECT_TRUE(isCanonicalDelaunay(points, triangles));
-  EXPECT_EQ(triangulatePermuted(points, rng), triangles);
+  EXPECT_EQ(triangulatePermuted(points, rng, GetParam()), triangles);
 }
 
-TEST(Delaunay2D, ResultIsPermutationInvariant)
+TEST_P(Delaunay2D, ResultIsPermutationInvariant)
 {
   std::mt19937 rng(42);
   const std::vector<Points> sets{uniformPoints(2000, 5000, rng),
@@ -720,11 +796,136 @@ TEST(Delaunay2D, ResultIsPermutationInvariant)
                                  rotatedLatticePoints(20, 30, 1234567, 654321),
                                  circleLatticePoints(5525, 0, 0)};
   for (const Points& points : sets) {
-    const Triangles triangles = triangulate(points);
+    const Triangles triangles = triangulate(points, GetParam());
     EXPECT_TRUE(isCanonicalDelaunay(points, triangles));
     for (int round = 0; round < 3; ++round)
-      EXPECT_EQ(triangulatePermuted(points, rng), triangles);
+      EXPECT_EQ(triangulatePermuted(points, rng, GetParam()), triangles);
   }
+}
+
+// The sweep must give exactly Boost's triangles: same canonical lists, on general
+// position, co-circular and collinear points, sorted and unsorted input.
+
+TEST(SweepMatchesBoost, RandomAndClusteredPoints)
+{
+  std::mt19937 rng(7);
+  for (const std::size_t n : {10, 100, 1000, 20000}) {
+    for (const std::int32_t range : {50, 1000, 1 << 20, kMaxDelaunayCoordinate}) {
+      Points points = uniformPoints(n, range, rng);
+      EXPECT_TRUE(sweepMatchesBoost(points)) << "uniform, range " << range;
+      std::sort(points.begin(), points.end());
+      EXPECT_TRUE(sweepMatchesBoost(points)) << "uniform sorted, range " << range;
+    }
+  }
+  EXPECT_TRUE(sweepMatchesBoost(clusteredPoints(20000, rng)));
+}
+
+TEST(SweepMatchesBoost, CoCircularAndLatticePoints)
+{
+  std::mt19937 rng(7);
+  for (const std::int32_t cells : {3, 10, 45, 200})
+    EXPECT_TRUE(sweepMatchesBoost(snappedPoints(5000, cells, 64, rng))) << cells;
+  EXPECT_TRUE(sweepMatchesBoost(gridPoints(1, 50, 0, 0, 3, 5)));
+  EXPECT_TRUE(sweepMatchesBoost(gridPoints(2, 50, 0, 0, 3, 5)));
+  EXPECT_TRUE(sweepMatchesBoost(gridPoints(60, 40, -100, 40, 3, 7)));
+  EXPECT_TRUE(sweepMatchesBoost(rotatedLatticePoints(20, 30, 1234567, 654321)));
+  EXPECT_TRUE(sweepMatchesBoost(rotatedLatticePoints(30, 40, 4, 3)));
+  EXPECT_TRUE(sweepMatchesBoost(circleLatticePoints(5525, 0, 0)));
+  Points circle_and_centre = circleLatticePoints(160225, 1 << 25, -(1 << 25));
+  circle_and_centre.push_back({1 << 25, -(1 << 25)});
+  EXPECT_TRUE(sweepMatchesBoost(circle_and_centre));
+}
+
+TEST(SweepMatchesBoost, DepthImageLikeGrids)
+{
+  std::mt19937 rng(7);
+  // Sorted, as SphericalDelaunay passes them: exact grid, jittered, sub-columns.
+  EXPECT_TRUE(sweepMatchesBoost(depthImagePoints(640, 480, 16000, 0, 0, false, rng)));
+  EXPECT_TRUE(sweepMatchesBoost(depthImagePoints(640, 480, 16000, 1, 1, false, rng)));
+  EXPECT_TRUE(sweepMatchesBoost(depthImagePoints(640, 480, 16000, 1, 40, true, rng)));
+  EXPECT_TRUE(
+      sweepMatchesBoost(depthImagePoints(320, 240, 16000, 2000, 2000, true, rng)));
+  // Unsorted.
+  Points points = depthImagePoints(320, 240, 16000, 1, 1, true, rng);
+  std::shuffle(points.begin(), points.end(), rng);
+  EXPECT_TRUE(sweepMatchesBoost(points));
+}
+
+TEST(SweepMatchesBoost, TinyAndDegenerateInputs)
+{
+  std::mt19937 rng(7);
+  for (int round = 0; round < 3000; ++round) {
+    // A few points in a tiny range: collinear and co-circular subsets everywhere.
+    const std::int32_t range = 1 + round % 6;
+    Points points = uniformPoints(3 + round % 30, range, rng);
+    EXPECT_TRUE(sweepMatchesBoost(points)) << "round " << round;
+    // The same far from the origin, stretched.
+    const std::int32_t scale = 1 + static_cast<std::int32_t>(rng() % 4000000);
+    const std::int32_t offset = static_cast<std::int32_t>(rng() % 20000000) - 10000000;
+    for (auto& p : points)
+      p = {p[0] * scale / 8 + offset, p[1] * scale / 8 - offset};
+    EXPECT_TRUE(sweepMatchesBoost(distinctShuffled(points, rng))) << "round " << round;
+  }
+  for (int round = 0; round < 300; ++round) {
+    // Points on a line, plus none to three others.
+    const std::int32_t dx = static_cast<std::int32_t>(rng() % 5) - 2;
+    const std::int32_t dy = dx == 0 ? 1 : static_cast<std::int32_t>(rng() % 5) - 2;
+    Points points;
+    for (std::int32_t k = 0; k < 2 + round % 40; ++k)
+      points.push_back({k * dx, k * dy});
+    for (int extra = round % 4; extra > 0; --extra)
+      points.push_back({static_cast<std::int32_t>(rng() % 21) - 10,
+                        static_cast<std::int32_t>(rng() % 21) - 10});
+    EXPECT_TRUE(sweepMatchesBoost(distinctShuffled(points, rng))) << "round " << round;
+  }
+}
+
+TEST(SweepMatchesBoost, PointsAtTheCoordinateLimits)
+{
+  std::mt19937 rng(7);
+  const std::int32_t max = kMaxDelaunayCoordinate;
+  std::uniform_int_distribution<std::int32_t> any(-max, max), near(0, 2);
+  for (int round = 0; round < 200; ++round) {
+    Points corners, flat;
+    for (int k = 0; k < 3 + round % 50; ++k) {
+      const bool at_limit = rng() % 3 == 0;
+      corners.push_back({at_limit ? (rng() % 2 ? max : -max) : any(rng),
+                         rng() % 3 == 0 ? (rng() % 2 ? max : -max) : any(rng)});
+      flat.push_back({rng() % 2 ? max - near(rng) : -max + near(rng), any(rng) % 4});
+    }
+    EXPECT_TRUE(sweepMatchesBoost(distinctShuffled(corners, rng))) << "round " << round;
+    EXPECT_TRUE(sweepMatchesBoost(distinctShuffled(flat, rng))) << "round " << round;
+  }
+}
+
+TEST(SweepMatchesBoost, LinesAndCurves)
+{
+  // Long collinear runs beside a single point, and points along concave curves, on
+  // which the sweep gives up after its flip budget and returns Boost's triangles.
+  const std::int32_t n = 3000;
+  for (const QuantizedPoint& single : {QuantizedPoint{n / 2, 5},
+                                       QuantizedPoint{n / 2, -5},
+                                       QuantizedPoint{-5, n / 2},
+                                       QuantizedPoint{n + 5, n / 2}}) {
+    Points row, column;
+    for (std::int32_t k = 0; k < n; ++k) {
+      row.push_back({k, 0});
+      column.push_back({0, k});
+    }
+    row.push_back(single);
+    column.push_back({single[1], single[0]});
+    EXPECT_TRUE(sweepMatchesBoost(row));
+    EXPECT_TRUE(sweepMatchesBoost(column));
+  }
+  const std::int32_t m = 20000;
+  Points opening_right, opening_up;
+  for (std::int32_t k = -m / 2; k < m / 2; ++k) {
+    const auto bend = static_cast<std::int32_t>(std::int64_t{k} * k / (m / 16));
+    opening_right.push_back({bend, k});
+    opening_up.push_back({k, bend});
+  }
+  EXPECT_TRUE(sweepMatchesBoost(opening_right));
+  EXPECT_TRUE(sweepMatchesBoost(opening_up));
 }
 
 TEST(ComputeTriangleNeighbours, MatchesBruteForceOnDelaunayTriangulations)

@@ -24,8 +24,19 @@ namespace {
 
 using detail::inCircle;
 using detail::orientation;
+using detail::setError;
 
 using VoronoiDiagram = boost::polygon::voronoi_diagram<double>;
+
+std::string
+describe(const QuantizedPoint& p)
+{
+  return "(" + std::to_string(p[0]) + ", " + std::to_string(p[1]) + ")";
+}
+
+} // namespace
+
+namespace detail {
 
 void
 setError(std::string* error, const std::string& message)
@@ -34,11 +45,94 @@ setError(std::string* error, const std::string& message)
     *error = message;
 }
 
-std::string
-describe(const QuantizedPoint& p)
+void
+reportDuplicate(const std::vector<QuantizedPoint>& points,
+                const QuantizedPoint& position,
+                std::string* error)
 {
-  return "(" + std::to_string(p[0]) + ", " + std::to_string(p[1]) + ")";
+  std::vector<std::size_t> ids;
+  for (std::size_t i = 0; i < points.size() && ids.size() < 2; ++i)
+    if (points[i] == position)
+      ids.push_back(i);
+  setError(error,
+           "delaunay2d: duplicate points " + std::to_string(ids[0]) + " and " +
+               std::to_string(ids[1]) + " at " + describe(position) +
+               " (the input must hold distinct points)");
 }
+
+bool
+allCollinear(const std::vector<QuantizedPoint>& points)
+{
+  for (std::size_t i = 2; i < points.size(); ++i)
+    if (orientation(points[0], points[1], points[i]) != 0)
+      return false;
+  return true;
+}
+
+void
+canonicalize(std::vector<Triangle>& triangles, std::size_t num_points)
+{
+  // A counting sort on the first id, then a sort of each bucket (the few triangles
+  // whose smallest vertex is the same) on the other two. A triangulation of at most
+  // 2^31 points has fewer than 2^32 triangles: 32-bit offsets suffice.
+  std::vector<std::uint32_t> ends(num_points + 1, 0);
+  for (auto& t : triangles) {
+    if (t[1] < t[0] && t[1] < t[2])
+      t = {t[1], t[2], t[0]};
+    else if (t[2] < t[0] && t[2] < t[1])
+      t = {t[2], t[0], t[1]};
+    ++ends[t[0] + 1];
+  }
+  std::partial_sum(ends.begin(), ends.end(), ends.begin());
+  std::vector<Triangle> sorted(triangles.size());
+  for (const auto& t : triangles)
+    sorted[ends[t[0]]++] = t;
+  // Each ends[v] has moved from the start of bucket v to its end.
+  const auto later = [](const Triangle& s, const Triangle& t) {
+    return s[1] > t[1] || (s[1] == t[1] && s[2] > t[2]);
+  };
+  std::size_t begin = 0;
+  for (std::size_t v = 0; v < num_points; ++v) {
+    const auto first = sorted.begin() + begin, last = sorted.begin() + ends[v];
+    if (last - first > 16) {
+      std::sort(first, last);
+    } else {
+      for (auto i = first + 1; i < last; ++i)
+        for (auto j = i; j > first && later(*(j - 1), *j); --j)
+          std::iter_swap(j, j - 1);
+    }
+    begin = ends[v];
+  }
+  triangles.swap(sorted);
+}
+
+void
+refanGroup(const std::vector<QuantizedPoint>& points,
+           const std::vector<index_t>& group,
+           std::vector<Triangle>& triangles,
+           std::vector<index_t>& corners)
+{
+  corners.clear();
+  for (const index_t t : group)
+    corners.insert(corners.end(), triangles[t].begin(), triangles[t].end());
+  std::sort(corners.begin(), corners.end());
+  corners.erase(std::unique(corners.begin(), corners.end()), corners.end());
+  const auto first =
+      std::min_element(corners.begin(), corners.end(), [&](index_t a, index_t b) {
+        return points[a] < points[b];
+      });
+  std::iter_swap(corners.begin(), first);
+  const QuantizedPoint& apex = points[corners[0]];
+  std::sort(corners.begin() + 1, corners.end(), [&](index_t a, index_t b) {
+    return orientation(apex, points[a], points[b]) > 0;
+  });
+  for (std::size_t s = 0; s < group.size(); ++s)
+    triangles[group[s]] = {corners[0], corners[s + 1], corners[s + 2]};
+}
+
+} // namespace detail
+
+namespace {
 
 // ----------------------------------------------------------------- preconditions
 
@@ -83,45 +177,11 @@ checkDistinct(const std::vector<QuantizedPoint>& points, std::string* error)
   const auto duplicate = std::adjacent_find(keys.begin(), keys.end());
   if (duplicate == keys.end())
     return true;
-  std::vector<std::size_t> ids;
-  for (std::size_t i = 0; i < points.size() && ids.size() < 2; ++i)
-    if (pointKey(points[i]) == *duplicate)
-      ids.push_back(i);
-  setError(error,
-           "delaunay2d: duplicate points " + std::to_string(ids[0]) + " and " +
-               std::to_string(ids[1]) + " at " + describe(points[ids[0]]) +
-               " (the input must hold distinct points)");
+  const auto at = std::find_if(points.begin(), points.end(), [&](const auto& p) {
+    return pointKey(p) == *duplicate;
+  });
+  detail::reportDuplicate(points, *at, error);
   return false;
-}
-
-bool
-allCollinear(const std::vector<QuantizedPoint>& points)
-{
-  for (std::size_t i = 2; i < points.size(); ++i)
-    if (orientation(points[0], points[1], points[i]) != 0)
-      return false;
-  return true;
-}
-
-/** Rotates each triangle so that its smallest id comes first, then sorts the list:
- * a counting sort on the first id, then a sort of each (small) bucket. */
-void
-canonicalize(std::vector<Triangle>& triangles, std::size_t num_points)
-{
-  std::vector<std::size_t> offsets(num_points + 1, 0);
-  for (auto& t : triangles) {
-    std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
-    ++offsets[t[0] + 1];
-  }
-  std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
-  std::vector<Triangle> sorted(triangles.size());
-  std::vector<std::size_t> cursor(offsets.begin(), offsets.end() - 1);
-  for (const auto& t : triangles)
-    sorted[cursor[t[0]]++] = t;
-  for (std::size_t v = 0; v < num_points; ++v)
-    if (offsets[v + 1] - offsets[v] > 1)
-      std::sort(sorted.begin() + offsets[v], sorted.begin() + offsets[v + 1]);
-  triangles.swap(sorted);
 }
 
 // ------------------------------------------------------- polygon triangulation
@@ -320,31 +380,6 @@ findRoot(std::vector<index_t>& parent, index_t t)
   return t;
 }
 
-/** Replaces the triangles of one co-circular group (a triangulated convex polygon) by
- * the fan from the polygon's lexicographically smallest point. */
-void
-refanGroup(const std::vector<QuantizedPoint>& points,
-           const std::vector<index_t>& group,
-           std::vector<Triangle>& triangles)
-{
-  std::vector<index_t> corners;
-  for (const index_t t : group)
-    corners.insert(corners.end(), triangles[t].begin(), triangles[t].end());
-  std::sort(corners.begin(), corners.end());
-  corners.erase(std::unique(corners.begin(), corners.end()), corners.end());
-  const auto first =
-      std::min_element(corners.begin(), corners.end(), [&](index_t a, index_t b) {
-        return points[a] < points[b];
-      });
-  std::iter_swap(corners.begin(), first);
-  const QuantizedPoint& apex = points[corners[0]];
-  std::sort(corners.begin() + 1, corners.end(), [&](index_t a, index_t b) {
-    return orientation(apex, points[a], points[b]) > 0;
-  });
-  for (std::size_t s = 0; s < group.size(); ++s)
-    triangles[group[s]] = {corners[0], corners[s + 1], corners[s + 2]};
-}
-
 /** Splits every group of co-circular triangles (joined across interior edges whose
  * in-circle determinant is zero) by the canonical fan. Expects a Delaunay
  * triangulation. */
@@ -368,12 +403,12 @@ canonicalizeCoCircular(const std::vector<QuantizedPoint>& points,
   for (index_t t = 0; t < num_triangles; ++t)
     members.emplace_back(findRoot(parent, t), t);
   std::sort(members.begin(), members.end());
-  std::vector<index_t> group;
+  std::vector<index_t> group, corners;
   for (std::size_t s = 0; s < members.size(); ++s) {
     group.push_back(members[s].second);
     if (s + 1 == members.size() || members[s + 1].first != members[s].first) {
       if (group.size() > 1)
-        refanGroup(points, group, triangles);
+        detail::refanGroup(points, group, triangles, corners);
       group.clear();
     }
   }
@@ -536,6 +571,8 @@ runBackend(const std::vector<QuantizedPoint>& points,
   switch (backend) {
   case DelaunayBackend::BoostVoronoi:
     return detail::delaunayBoostVoronoi(points, triangles, error);
+  case DelaunayBackend::Sweep:
+    return detail::delaunaySweep(points, triangles, error);
   case DelaunayBackend::Vtk:
 #ifdef PCL_SELSEG_HAVE_VTK
     return detail::delaunayVtk(points, triangles, error);
@@ -559,6 +596,8 @@ toString(DelaunayBackend backend)
     return "boost";
   case DelaunayBackend::Vtk:
     return "vtk";
+  case DelaunayBackend::Sweep:
+    return "sweep";
   }
   return "unknown";
 }
@@ -568,6 +607,7 @@ isDelaunayBackendAvailable(DelaunayBackend backend)
 {
   switch (backend) {
   case DelaunayBackend::BoostVoronoi:
+  case DelaunayBackend::Sweep:
     return true;
   case DelaunayBackend::Vtk:
 #ifdef PCL_SELSEG_HAVE_VTK
@@ -593,15 +633,21 @@ delaunay2d(const std::vector<QuantizedPoint>& points,
                  (backend == DelaunayBackend::Vtk ? " (compiled without VTK)" : ""));
     return false;
   }
-  if (!checkRange(points, error) || !checkDistinct(points, error))
+  if (!checkRange(points, error))
     return false;
-  if (points.size() < 3 || allCollinear(points))
+  // The sweep sorts the points anyway, which finds duplicates at no extra cost; it
+  // also returns its triangles in canonical order.
+  if (backend == DelaunayBackend::Sweep)
+    return detail::delaunaySweep(points, triangles, error);
+  if (!checkDistinct(points, error))
+    return false;
+  if (points.size() < 3 || detail::allCollinear(points))
     return true;
   if (!runBackend(points, backend, triangles, error)) {
     triangles.clear();
     return false;
   }
-  canonicalize(triangles, points.size());
+  detail::canonicalize(triangles, points.size());
   return true;
 }
 

@@ -26,6 +26,8 @@ __extension__ typedef __int128 Int128;
  *
  * Exact for |coordinate| <= kMaxDelaunayCoordinate = 2^26: every difference is at most
  * 2^27 in magnitude, each product at most 2^54 and the result at most 2^55 < 2^63.
+ * Still exact while the coordinate differences stay below 2^29 (the sweep's artificial
+ * points): products below 2^58, the result below 2^59.
  */
 inline std::int64_t
 orientation(const QuantizedPoint& a, const QuantizedPoint& b, const QuantizedPoint& c)
@@ -43,7 +45,9 @@ orientation(const QuantizedPoint& a, const QuantizedPoint& b, const QuantizedPoi
  * Exact for |coordinate| <= 2^26. With differences to d of magnitude <= 2^27, each
  * lifted term dx^2 + dy^2 is <= 2^55 and each 2x2 minor dx1 * dy2 - dx2 * dy1 is
  * <= 2^55, both fitting in int64. Each of the three products is <= 2^110, so the
- * determinant is <= 3 * 2^110 < 2^112, far inside the int128 range (2^127).
+ * determinant is <= 3 * 2^110 < 2^112, far inside the int128 range (2^127). Still exact
+ * while the differences stay below 2^29 (the sweep's artificial points): lifted terms
+ * and minors below 2^59, the determinant below 3 * 2^118 < 2^120.
  */
 inline Int128
 inCircle(const QuantizedPoint& a,
@@ -65,6 +69,30 @@ inCircle(const QuantizedPoint& a,
          Int128{c_lift} * (adx * bdy - bdx * ady);
 }
 
+/** \brief Sets *error to \a message when \a error is not null. */
+void setError(std::string* error, const std::string& message);
+
+/** \brief The error for a duplicated point: names the first two ids at \a position,
+ * which must occur at least twice in \a points. */
+void reportDuplicate(const std::vector<QuantizedPoint>& points,
+                     const QuantizedPoint& position,
+                     std::string* error);
+
+/** \brief Whether all points lie on one line (true for fewer than three points). */
+bool allCollinear(const std::vector<QuantizedPoint>& points);
+
+/** \brief Rotates each triangle so that its smallest id comes first, then sorts the
+ * list (linear time: a counting sort on the first id, then small buckets). */
+void canonicalize(std::vector<Triangle>& triangles, std::size_t num_points);
+
+/** \brief Replaces the triangles of one co-circular group (a triangulated convex
+ * polygon, \a group its triangle indices) by the fan from the polygon's
+ * lexicographically smallest point. \a corners is scratch space. */
+void refanGroup(const std::vector<QuantizedPoint>& points,
+                const std::vector<index_t>& group,
+                std::vector<Triangle>& triangles,
+                std::vector<index_t>& corners);
+
 /** \brief Exact Delaunay triangulation through the dual of Boost.Polygon's Voronoi
  * diagram, co-circular polygons split by the canonical fan rule.
  *
@@ -75,6 +103,21 @@ inCircle(const QuantizedPoint& a,
 bool delaunayBoostVoronoi(const std::vector<QuantizedPoint>& points,
                           std::vector<Triangle>& triangles,
                           std::string* error);
+
+/** \brief Exact Delaunay triangulation by an advancing-front sweep over the points in
+ * lexicographic order (delaunay_2d_sweep.cpp), co-circular polygons split by the
+ * canonical fan rule: the triangles of delaunayBoostVoronoi(), much faster.
+ *
+ * Expects coordinates within range (delaunay2d() checks). Unlike the other backends it
+ * does the rest of delaunay2d()'s work itself: it finds duplicates while ordering the
+ * points (same error as delaunay2d()), returns no triangles for fewer than three or
+ * collinear points, and lists the triangles in canonical order. On inputs where the
+ * sweep order is a bad insertion order (points along concave curves) it gives up after
+ * a budget of flips and returns delaunayBoostVoronoi()'s triangles.
+ */
+bool delaunaySweep(const std::vector<QuantizedPoint>& points,
+                   std::vector<Triangle>& triangles,
+                   std::string* error);
 
 /** \brief Triangulation by vtkDelaunay2D (floating point), triangles oriented counter-
  * clockwise by the exact orientation, degenerate ones dropped, not in canonical order.

@@ -1,0 +1,795 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
+ */
+
+/* The Sweep backend of delaunay2d(): an advancing-front sweep over the points in
+ * lexicographic order with exact integer predicates, one exact pass over all edges that
+ * repairs and classifies them, then the canonical fans. See docs/delaunay.md. */
+
+#include <pcl_selective_seg/delaunay_2d.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <memory>
+#include <vector>
+
+#include "delaunay_2d_backends.h"
+
+namespace pcl {
+namespace selective_seg {
+
+namespace {
+
+using detail::inCircle;
+using detail::Int128;
+using detail::orientation;
+
+constexpr index_t kNone = -1;
+
+// ------------------------------------------------------------------ the order
+
+bool
+isStrictlySorted(const std::vector<QuantizedPoint>& points)
+{
+  for (std::size_t i = 1; i < points.size(); ++i)
+    if (!(points[i - 1] < points[i]))
+      return false;
+  return true;
+}
+
+/** Number of bits needed to write \a value. */
+int
+bitWidth(std::uint64_t value)
+{
+  int bits = 0;
+  while (value >> bits)
+    ++bits;
+  return bits;
+}
+
+/** Keys ordered like the points (x, then y), packed relative to the smallest
+ * coordinates; \a bits receives the number of bits the keys use. */
+std::vector<std::uint64_t>
+sortKeys(const std::vector<QuantizedPoint>& points, int& bits)
+{
+  std::int64_t min_x = points[0][0], max_x = min_x, min_y = points[0][1], max_y = min_y;
+  for (const auto& p : points) {
+    min_x = std::min<std::int64_t>(min_x, p[0]);
+    max_x = std::max<std::int64_t>(max_x, p[0]);
+    min_y = std::min<std::int64_t>(min_y, p[1]);
+    max_y = std::max<std::int64_t>(max_y, p[1]);
+  }
+  const int y_bits = bitWidth(static_cast<std::uint64_t>(max_y - min_y));
+  bits = y_bits + bitWidth(static_cast<std::uint64_t>(max_x - min_x));
+  std::vector<std::uint64_t> keys(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i)
+    keys[i] = (static_cast<std::uint64_t>(points[i][0] - min_x) << y_bits) |
+              static_cast<std::uint64_t>(points[i][1] - min_y);
+  return keys;
+}
+
+/** The ids of \a points in lexicographic order (a stable least-significant-digit radix
+ * sort of their keys); \a keys receives the sorted keys. */
+std::vector<index_t>
+sortedOrder(const std::vector<QuantizedPoint>& points, std::vector<std::uint64_t>& keys)
+{
+  int bits = 0;
+  keys = sortKeys(points, bits);
+  const std::size_t n = points.size();
+  std::vector<index_t> order(n);
+  for (std::size_t i = 0; i < n; ++i)
+    order[i] = static_cast<index_t>(i);
+  const int passes = std::max(1, (bits + 10) / 11);
+  const int digit_bits = (bits + passes - 1) / passes;
+  const std::uint64_t mask = (std::uint64_t{1} << digit_bits) - 1;
+  std::vector<std::uint64_t> key_buffer(n);
+  std::vector<index_t> order_buffer(n);
+  std::vector<std::size_t> offsets(mask + 2);
+  for (int pass = 0; pass < passes; ++pass) {
+    const int shift = pass * digit_bits;
+    std::fill(offsets.begin(), offsets.end(), 0);
+    for (const std::uint64_t key : keys)
+      ++offsets[((key >> shift) & mask) + 1];
+    for (std::size_t d = 1; d < offsets.size(); ++d)
+      offsets[d] += offsets[d - 1];
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::size_t slot = offsets[(keys[i] >> shift) & mask]++;
+      key_buffer[slot] = keys[i];
+      order_buffer[slot] = order[i];
+    }
+    keys.swap(key_buffer);
+    order.swap(order_buffer);
+  }
+  return order;
+}
+
+// -------------------------------------------------------------- the half-edges
+
+/** Triangle of half-edge \a e: half-edges 4t, 4t + 1, 4t + 2 belong to triangle t (a
+ * stride of four keeps these helpers to bit operations; ids 4t + 3 are unused). */
+inline index_t
+triangleOf(index_t e)
+{
+  return e >> 2;
+}
+
+/** Corner of half-edge \a e in its triangle: e runs from that corner to the next. */
+inline int
+cornerOf(index_t e)
+{
+  return e & 3;
+}
+
+/** Next half-edge counter-clockwise in the same triangle. */
+inline index_t
+nextEdge(index_t e)
+{
+  return cornerOf(e) == 2 ? e - 2 : e + 1;
+}
+
+/** Previous half-edge counter-clockwise in the same triangle. */
+inline index_t
+previousEdge(index_t e)
+{
+  return cornerOf(e) == 0 ? e + 2 : e - 1;
+}
+
+/** Whether the corner at b of the path a -> b -> c is a notch of an upward front worth
+ * closing by the triangle (a, c, b) right away: a right turn with an angle below about
+ * 100 degrees (its cosine above -1/5). Closing these keeps the front short and its
+ * edges local; wider notches wait for the end. Exact: the products stay below 2^123. */
+bool
+isSharpNotch(const QuantizedPoint& a, const QuantizedPoint& b, const QuantizedPoint& c)
+{
+  if (orientation(a, b, c) >= 0)
+    return false;
+  const std::int64_t ax = std::int64_t{a[0]} - b[0], ay = std::int64_t{a[1]} - b[1];
+  const std::int64_t cx = std::int64_t{c[0]} - b[0], cy = std::int64_t{c[1]} - b[1];
+  const std::int64_t dot = ax * cx + ay * cy;
+  if (dot >= 0)
+    return true;
+  const Int128 lengths = Int128{ax * ax + ay * ay} * (cx * cx + cy * cy);
+  return 25 * (Int128{dot} * dot) < lengths;
+}
+
+/** A triangulation of distinct points sorted lexicographically, not all collinear,
+ * built by an advancing-front sweep: Delaunay but for the few edges that the sweep's
+ * local flips miss (repairAndClassify() flips those).
+ *
+ * Two artificial points, far below and far above the points and left of them, start
+ * the front: the right boundary of the triangulated region, a chain of non-decreasing
+ * y from the bottom point to the top one. Each new point, lexicographically larger than
+ * all before it, lies strictly right of the front edge spanning its y and becomes the
+ * apex of a new triangle on that edge; the sharp notches it leaves on either side are
+ * closed, and Lawson's exact flips check every new edge. At the end, the pockets
+ * between the front and its convex hull are filled and the artificial points are
+ * flipped away.
+ *
+ * Storage: triangle t holds its corners counter-clockwise and owns half-edges 4t + i,
+ * from corner i to corner i + 1; twin(e) is the opposite half-edge in the neighbouring
+ * triangle, kNone on the boundary. Removed triangles hold kNone corners.
+ */
+class SweepTriangulation {
+public:
+  explicit SweepTriangulation(const std::vector<QuantizedPoint>& points);
+
+  /** Sweeps, completes the convex hull, removes the artificial points, then repairs and
+   * classifies every edge (repairAndClassify()). Returns false, unfinished, if that
+   * takes more than about 16 flips per point: insertion in sweep order can flip much
+   * of the triangulation at each point on inputs such as points along concave curves,
+   * while area-sampled clouds need fewer than one flip per point. */
+  bool build();
+
+  /** Triangles, removed ones included (kNone corners). */
+  std::vector<Triangle>& triangles() { return triangles_; }
+
+  index_t numHalfEdges() const { return 4 * static_cast<index_t>(triangles_.size()); }
+
+  index_t origin(index_t e) const { return triangles_[triangleOf(e)][cornerOf(e)]; }
+
+  index_t twin(index_t e) const { return twins_[e]; }
+
+  /** Whether the triangles on both sides of interior half-edge \a e share their
+   * circumcircle (valid after repairAndClassify()). */
+  bool isOnCircle(index_t e) const { return circle_[e] == kOnCircle; }
+
+private:
+  /** What the last in-circle test of an edge found, while its two triangles remain. */
+  enum CircleState : char { kUntested = 0, kOffCircle, kOnCircle };
+
+  /** In-circle determinant of the vertex across interior half-edge \a e against the
+   * circumcircle of e's triangle: positive if the edge is not locally Delaunay. */
+  Int128 inCircleAcross(index_t e) const
+  {
+    return inCircle(points_[origin(e)],
+                    points_[origin(nextEdge(e))],
+                    points_[origin(previousEdge(e))],
+                    points_[origin(previousEdge(twins_[e]))]);
+  }
+
+  Int128 classify(index_t e);
+  void forget(index_t e);
+  bool repairAndClassify();
+  bool overBudget() const { return flips_ > flip_budget_; }
+  void flip(index_t e);
+  void start();
+  void insert(index_t p);
+  index_t locate(index_t p);
+  void closeNotchesAbove(index_t p);
+  bool closeNotchBelow(index_t p, bool sharp_only);
+  void convexifyFront();
+  void removeVertex(index_t v);
+  void flipSpokesAway(index_t v, index_t boundary_spoke);
+  bool canFlipSpoke(index_t v, index_t s) const;
+  double earPower(index_t v, index_t s) const;
+  void deleteStar(index_t boundary_spoke);
+  index_t addTriangle(index_t a, index_t b, index_t c);
+  void setCorner(index_t e, index_t v);
+  void link(index_t e, index_t other);
+  void joinFront(index_t lower, index_t upper);
+  void legalize();
+  bool flipIfIllegal(index_t e);
+
+  /** The input points, then the bottom and the top artificial point. */
+  std::vector<QuantizedPoint> points_;
+  index_t bottom_ = 0, top_ = 0;
+  std::vector<Triangle> triangles_;
+  /** Per half-edge (four per triangle), allocated for the most triangles the sweep
+   * can make: the twin, and the CircleState of the edge. */
+  std::unique_ptr<index_t[]> twins_;
+  std::unique_ptr<CircleState[]> circle_;
+  /** Front links, kNone off the front. Once the front is done, flipSpokesAway() uses
+   * them as scratch (a spoke and an ear stamp per vertex). */
+  std::vector<index_t> front_next_, front_previous_;
+  /** Per vertex, a boundary half-edge leaving it: on the front, the one to its
+   * successor. */
+  std::vector<index_t> boundary_edge_;
+  /** Front vertices by y bucket (a hint: entries may have left the front). */
+  std::vector<index_t> buckets_;
+  std::int64_t bucket_base_ = 0;
+  int bucket_shift_ = 0;
+  std::vector<index_t> stack_;
+  std::int64_t flips_ = 0, flip_budget_ = 0;
+};
+
+SweepTriangulation::SweepTriangulation(const std::vector<QuantizedPoint>& points)
+    : points_(points)
+{
+  const auto n = static_cast<index_t>(points.size());
+  points_.reserve(points.size() + 2);
+  // The sweep creates 2 (n + 2) - 5 triangles at most.
+  triangles_.reserve(2 * static_cast<std::size_t>(n) + 4);
+  twins_.reset(new index_t[8 * static_cast<std::size_t>(n) + 16]);
+  circle_.reset(new CircleState[8 * static_cast<std::size_t>(n) + 16]);
+  front_next_.assign(n + 2, kNone);
+  front_previous_.assign(n + 2, kNone);
+  boundary_edge_.assign(n + 2, kNone);
+  stack_.reserve(64);
+  flip_budget_ = 16 * std::int64_t{n} + 65536;
+}
+
+bool
+SweepTriangulation::build()
+{
+  const auto n = static_cast<index_t>(points_.size());
+  start();
+  for (index_t p = 1; p < n; ++p) {
+    insert(p);
+    if (overBudget())
+      return false;
+  }
+  convexifyFront();
+  if (overBudget())
+    return false;
+  removeVertex(bottom_);
+  removeVertex(top_);
+  return repairAndClassify();
+}
+
+/** Places the artificial points and the first triangle (bottom, point 0, top). They
+ * lie up to 2^27 beyond the points, so coordinate differences stay below 2^29, where
+ * the predicates are still exact (int64 / int128, see the bounds in
+ * delaunay_2d_backends.h). */
+void
+SweepTriangulation::start()
+{
+  std::int32_t min_y = points_[0][1], max_y = min_y;
+  for (const auto& p : points_) {
+    min_y = std::min(min_y, p[1]);
+    max_y = std::max(max_y, p[1]);
+  }
+  const std::int32_t far =
+      std::min(std::max(max_y - min_y, points_.back()[0] - points_[0][0]) + 16,
+               2 * kMaxDelaunayCoordinate);
+  bottom_ = static_cast<index_t>(points_.size());
+  top_ = bottom_ + 1;
+  points_.push_back({points_[0][0] - far, min_y - far});
+  points_.push_back({points_[0][0] - far, max_y + far});
+  const index_t e = addTriangle(bottom_, 0, top_);
+  twins_[e] = twins_[e + 1] = twins_[e + 2] = kNone;
+  boundary_edge_[bottom_] = e;
+  boundary_edge_[0] = e + 1;
+  boundary_edge_[top_] = e + 2;
+  joinFront(bottom_, 0);
+  joinFront(0, top_);
+  // About two buckets per front vertex of a square cloud.
+  int shift = 0;
+  const std::int64_t range = std::int64_t{max_y} - min_y;
+  const auto wanted = static_cast<std::int64_t>(2 * std::sqrt(points_.size()) + 16);
+  while ((range >> shift) >= wanted)
+    ++shift;
+  bucket_base_ = min_y;
+  bucket_shift_ = shift;
+  buckets_.assign(static_cast<std::size_t>(range >> shift) + 1, kNone);
+  buckets_[(std::int64_t{points_[0][1]} - min_y) >> shift] = 0;
+}
+
+/** Inserts \a p on the front edge spanning its y, closes the sharp notches beside it
+ * and restores the Delaunay property around the new triangles. */
+void
+SweepTriangulation::insert(index_t p)
+{
+  const index_t a = locate(p);
+  const index_t b = front_next_[a];
+  const index_t e = addTriangle(a, p, b);
+  twins_[e] = twins_[e + 1] = kNone;
+  link(e + 2, boundary_edge_[a]);
+  boundary_edge_[a] = e;
+  boundary_edge_[p] = e + 1;
+  joinFront(a, p);
+  joinFront(p, b);
+  stack_.push_back(e + 2);
+  legalize();
+  closeNotchesAbove(p);
+  while (closeNotchBelow(p, true)) {
+  }
+  buckets_[(std::int64_t{points_[p][1]} - bucket_base_) >> bucket_shift_] = p;
+}
+
+/** The front vertex a with y(a) <= y(p) < y(front_next_[a]), found from the nearest
+ * bucket at or below p's. */
+index_t
+SweepTriangulation::locate(index_t p)
+{
+  const std::int32_t y = points_[p][1];
+  auto bucket = (std::int64_t{y} - bucket_base_) >> bucket_shift_;
+  index_t a = bottom_;
+  for (; bucket >= 0; --bucket) {
+    const index_t v = buckets_[bucket];
+    if (v != kNone && front_next_[v] != kNone) {
+      a = v;
+      break;
+    }
+  }
+  while (points_[front_next_[a]][1] <= y)
+    a = front_next_[a];
+  while (points_[a][1] > y)
+    a = front_previous_[a];
+  return a;
+}
+
+/** Closes the sharp notches above \a p: while p -> b -> c is one, adds (p, c, b). */
+void
+SweepTriangulation::closeNotchesAbove(index_t p)
+{
+  while (true) {
+    const index_t b = front_next_[p];
+    const index_t c = front_next_[b];
+    if (c == kNone || !isSharpNotch(points_[p], points_[b], points_[c]))
+      return;
+    const index_t e = addTriangle(p, c, b);
+    twins_[e] = kNone;
+    link(e + 1, boundary_edge_[b]);
+    link(e + 2, boundary_edge_[p]);
+    boundary_edge_[p] = e;
+    front_next_[b] = front_previous_[b] = kNone;
+    joinFront(p, c);
+    stack_.push_back(e + 1);
+    stack_.push_back(e + 2);
+    legalize();
+  }
+}
+
+/** Closes the notch below \a p, z -> a -> p (a right turn; if \a sharp_only, a sharp
+ * one), by the triangle (z, p, a); returns whether there was one. */
+bool
+SweepTriangulation::closeNotchBelow(index_t p, bool sharp_only)
+{
+  const index_t a = front_previous_[p];
+  const index_t z = a == kNone ? kNone : front_previous_[a];
+  if (z == kNone)
+    return false;
+  const bool notch = sharp_only ? isSharpNotch(points_[z], points_[a], points_[p])
+                                : orientation(points_[z], points_[a], points_[p]) < 0;
+  if (!notch)
+    return false;
+  const index_t e = addTriangle(z, p, a);
+  twins_[e] = kNone;
+  link(e + 1, boundary_edge_[a]);
+  link(e + 2, boundary_edge_[z]);
+  boundary_edge_[z] = e;
+  front_next_[a] = front_previous_[a] = kNone;
+  joinFront(z, p);
+  stack_.push_back(e + 1);
+  stack_.push_back(e + 2);
+  legalize();
+  return true;
+}
+
+/** Closes every notch of the front, bottom to top (a Graham scan), each new triangle
+ * checked by Lawson's flips: the region becomes the convex hull of all points, the
+ * artificial ones included. */
+void
+SweepTriangulation::convexifyFront()
+{
+  for (index_t v = front_next_[bottom_]; v != kNone && !overBudget();
+       v = front_next_[v]) {
+    while (closeNotchBelow(v, false)) {
+    }
+  }
+}
+
+/** Removes artificial hull vertex \a v: flips its spokes away while one can be
+ * flipped, which leaves a convex chain of its neighbours, then deletes its remaining
+ * triangles. */
+void
+SweepTriangulation::removeVertex(index_t v)
+{
+  const index_t spoke = boundary_edge_[v];
+  if (spoke == kNone || origin(spoke) != v)
+    return;
+  flipSpokesAway(v, spoke);
+  deleteStar(boundary_edge_[v]);
+  boundary_edge_[v] = kNone;
+}
+
+/** Flips the interior spokes of hull vertex \a v away while one can be flipped: spoke
+ * v -> u, between the triangles (v, u, after) and (v, before, u), becomes the edge
+ * before - after when both new triangles are counter-clockwise. Ears (before, u, after)
+ * go first by the power of v with respect to their circumcircle, smallest first, which
+ * makes the new triangles Delaunay where the triangulation was; the order only saves
+ * flips in repairAndClassify(), any order gives a valid triangulation. */
+void
+SweepTriangulation::flipSpokesAway(index_t v, index_t boundary_spoke)
+{
+  struct Ear {
+    double power;
+    index_t vertex, stamp;
+    bool operator>(const Ear& other) const { return power > other.power; }
+  };
+  std::vector<index_t>& spoke_of = front_next_;
+  std::vector<index_t>& stamp = front_previous_;
+  std::vector<Ear> heap;
+  const auto push = [&](index_t s) {
+    const index_t u = origin(nextEdge(s));
+    spoke_of[u] = s;
+    heap.push_back({earPower(v, s), u, ++stamp[u]});
+    std::push_heap(heap.begin(), heap.end(), std::greater<>());
+  };
+  for (index_t s = twins_[previousEdge(boundary_spoke)]; s != kNone;
+       s = twins_[previousEdge(s)])
+    push(s);
+  while (!heap.empty()) {
+    std::pop_heap(heap.begin(), heap.end(), std::greater<>());
+    const Ear ear = heap.back();
+    heap.pop_back();
+    const index_t s = spoke_of[ear.vertex];
+    if (ear.stamp != stamp[ear.vertex] || !canFlipSpoke(v, s))
+      continue;
+    flip(s);
+    ++stamp[ear.vertex];
+    if (twins_[s] != kNone)
+      push(s);
+    const index_t next_spoke = twins_[previousEdge(s)];
+    if (next_spoke != kNone)
+      push(next_spoke);
+  }
+}
+
+/** Whether interior spoke \a s of vertex \a v can be flipped: both triangles it would
+ * leave are strictly counter-clockwise. */
+bool
+SweepTriangulation::canFlipSpoke(index_t v, index_t s) const
+{
+  const QuantizedPoint& u = points_[origin(nextEdge(s))];
+  const QuantizedPoint& after = points_[origin(previousEdge(s))];
+  const QuantizedPoint& before = points_[origin(previousEdge(twins_[s]))];
+  return orientation(points_[v], before, after) > 0 &&
+         orientation(u, after, before) > 0;
+}
+
+/** Power of vertex \a v with respect to the circumcircle of the ear of spoke \a s
+ * (floating point: it only orders the flips). */
+double
+SweepTriangulation::earPower(index_t v, index_t s) const
+{
+  const QuantizedPoint& u = points_[origin(nextEdge(s))];
+  const auto offset = [&](index_t w) {
+    return std::array<double, 2>{static_cast<double>(points_[w][0]) - u[0],
+                                 static_cast<double>(points_[w][1]) - u[1]};
+  };
+  const auto a = offset(origin(previousEdge(twins_[s])));
+  const auto b = offset(origin(previousEdge(s)));
+  const auto w = offset(v);
+  const double twice_area = 2 * (a[0] * b[1] - a[1] * b[0]);
+  if (twice_area == 0)
+    return std::numeric_limits<double>::infinity();
+  const double a2 = a[0] * a[0] + a[1] * a[1], b2 = b[0] * b[0] + b[1] * b[1];
+  const double centre_x = (a2 * b[1] - b2 * a[1]) / twice_area;
+  const double centre_y = (b2 * a[0] - a2 * b[0]) / twice_area;
+  return w[0] * w[0] + w[1] * w[1] - 2 * (w[0] * centre_x + w[1] * centre_y);
+}
+
+/** Deletes the triangles around a hull vertex, from its boundary spoke on; the edges
+ * they shared with other triangles become boundary edges. */
+void
+SweepTriangulation::deleteStar(index_t boundary_spoke)
+{
+  index_t s = boundary_spoke;
+  while (s != kNone) {
+    const index_t outer = twins_[nextEdge(s)];
+    if (outer != kNone) {
+      twins_[outer] = kNone;
+      circle_[outer] = kUntested;
+      boundary_edge_[origin(outer)] = outer;
+    }
+    const index_t next_spoke = twins_[previousEdge(s)];
+    triangles_[triangleOf(s)] = {kNone, kNone, kNone};
+    s = next_spoke;
+  }
+}
+
+/** Appends the counter-clockwise triangle (a, b, c); returns its first half-edge,
+ * a -> b. The twins are left to the caller. */
+index_t
+SweepTriangulation::addTriangle(index_t a, index_t b, index_t c)
+{
+  const index_t e = numHalfEdges();
+  triangles_.push_back({a, b, c});
+  circle_[e] = circle_[e + 1] = circle_[e + 2] = kUntested;
+  return e;
+}
+
+void
+SweepTriangulation::setCorner(index_t e, index_t v)
+{
+  triangles_[triangleOf(e)][cornerOf(e)] = v;
+}
+
+void
+SweepTriangulation::link(index_t e, index_t other)
+{
+  twins_[e] = other;
+  twins_[other] = e;
+}
+
+void
+SweepTriangulation::joinFront(index_t lower, index_t upper)
+{
+  front_next_[lower] = upper;
+  front_previous_[upper] = lower;
+}
+
+/** Tests interior half-edge \a e (see inCircleAcross()) and, unless it is illegal,
+ * records whether it is on the circle. */
+inline Int128
+SweepTriangulation::classify(index_t e)
+{
+  const Int128 inside = inCircleAcross(e);
+  if (inside <= 0)
+    circle_[e] = circle_[twins_[e]] = inside == 0 ? kOnCircle : kOffCircle;
+  return inside;
+}
+
+/** Checks the edges on the stack, flipping the illegal ones; a flip puts the two edges
+ * it exposes to the same apex on the stack. */
+void
+SweepTriangulation::legalize()
+{
+  while (!stack_.empty()) {
+    const index_t e = stack_.back();
+    stack_.pop_back();
+    while (flipIfIllegal(e)) {
+    }
+  }
+}
+
+/** Flips interior half-edge \a e, a -> b of triangle (a, b, p), if the vertex d across
+ * lies strictly inside the circumcircle; then e is a -> d of (a, d, p), and the edge
+ * d -> b of (b, p, d) goes on the stack. */
+bool
+SweepTriangulation::flipIfIllegal(index_t e)
+{
+  const index_t o = twins_[e];
+  if (o == kNone || classify(e) <= 0)
+    return false;
+  flip(e);
+  stack_.push_back(previousEdge(o));
+  return true;
+}
+
+/** Marks the edge of half-edge \a e untested (its triangles changed). */
+void
+SweepTriangulation::forget(index_t e)
+{
+  circle_[e] = kUntested;
+  if (twins_[e] != kNone)
+    circle_[twins_[e]] = kUntested;
+}
+
+/** Flips interior half-edge \a e, a -> b, between the triangles (a, b, p) and
+ * (b, a, d): they become (a, d, p), with e now a -> d, and (b, p, d) in the other
+ * triangle, with twin(e) now b -> p. */
+void
+SweepTriangulation::flip(index_t e)
+{
+  ++flips_;
+  const index_t o = twins_[e];
+  const index_t e_next = nextEdge(e), o_next = nextEdge(o);
+  const index_t a = origin(e), b = origin(e_next);
+  const index_t outer_ad = twins_[o_next], outer_bp = twins_[e_next];
+  setCorner(e_next, origin(previousEdge(o)));
+  setCorner(o_next, origin(previousEdge(e)));
+  if (outer_ad == kNone) {
+    twins_[e] = kNone;
+    boundary_edge_[a] = e;
+  } else {
+    link(e, outer_ad);
+  }
+  if (outer_bp == kNone) {
+    twins_[o] = kNone;
+    boundary_edge_[b] = o;
+  } else {
+    link(o, outer_bp);
+  }
+  link(e_next, o_next);
+  for (const index_t changed : {e, previousEdge(e), e_next, o, previousEdge(o)})
+    forget(changed);
+}
+
+// --------------------------------------------------- repair and co-circular groups
+
+/** Flips the edges the sweep left illegal (Lawson's flips, exact, strict) and tests
+ * the edges no test has classified yet, so that every interior edge is locally
+ * Delaunay and known to be on or off the circumcircle across it. False if over
+ * budget. */
+bool
+SweepTriangulation::repairAndClassify()
+{
+  std::vector<index_t>& illegal = stack_;
+  for (index_t t = 0; t < static_cast<index_t>(triangles_.size()); ++t) {
+    if (triangles_[t][0] == kNone)
+      continue;
+    for (index_t e = 4 * t; e < 4 * t + 3; ++e)
+      if (circle_[e] == kUntested && twins_[e] > e && classify(e) > 0)
+        illegal.push_back(e);
+  }
+  while (!illegal.empty() && !overBudget()) {
+    const index_t e = illegal.back();
+    illegal.pop_back();
+    const index_t o = twins_[e];
+    if (o == kNone || classify(e) <= 0)
+      continue;
+    flip(e);
+    for (const index_t exposed : {e, previousEdge(e), nextEdge(e), o, previousEdge(o)})
+      illegal.push_back(exposed);
+  }
+  return !overBudget();
+}
+
+/** Splits every group of co-circular triangles (joined across marked edges: the
+ * triangulation of one empty circle's polygon) by the canonical fan, in place. */
+void
+refanCoCircular(const std::vector<QuantizedPoint>& points, SweepTriangulation& mesh)
+{
+  std::vector<Triangle>& triangles = mesh.triangles();
+  std::vector<char> visited(triangles.size(), 0);
+  std::vector<index_t> group, pending, corners;
+  const auto on_circle = [&](index_t t) {
+    return mesh.isOnCircle(4 * t) || mesh.isOnCircle(4 * t + 1) ||
+           mesh.isOnCircle(4 * t + 2);
+  };
+  for (index_t t = 0; t < static_cast<index_t>(triangles.size()); ++t) {
+    if (visited[t] || triangles[t][0] == kNone || !on_circle(t))
+      continue;
+    group.clear();
+    pending.assign(1, t);
+    visited[t] = 1;
+    while (!pending.empty()) {
+      const index_t u = pending.back();
+      pending.pop_back();
+      group.push_back(u);
+      for (index_t e = 4 * u; e < 4 * u + 3; ++e) {
+        const index_t w = mesh.isOnCircle(e) ? triangleOf(mesh.twin(e)) : kNone;
+        if (w != kNone && !visited[w]) {
+          visited[w] = 1;
+          pending.push_back(w);
+        }
+      }
+    }
+    detail::refanGroup(points, group, triangles, corners);
+  }
+}
+
+/** The Delaunay triangulation of distinct points sorted lexicographically, not all
+ * collinear, with the canonical fans, in the points' ids (not in canonical order).
+ * False if the sweep ran out of budget (SweepTriangulation::build()). */
+bool
+triangulateSorted(const std::vector<QuantizedPoint>& points,
+                  std::vector<Triangle>& triangles)
+{
+  SweepTriangulation mesh(points);
+  if (!mesh.build())
+    return false;
+  refanCoCircular(points, mesh);
+  triangles.swap(mesh.triangles());
+  triangles.erase(std::remove_if(triangles.begin(),
+                                 triangles.end(),
+                                 [](const Triangle& t) { return t[0] == kNone; }),
+                  triangles.end());
+  return true;
+}
+
+/** BoostVoronoi's triangles in canonical order, for the inputs the sweep gives up on:
+ * the same triangles, in about Boost's time. */
+bool
+triangulateByBoost(const std::vector<QuantizedPoint>& points,
+                   std::vector<Triangle>& triangles,
+                   std::string* error)
+{
+  if (!detail::delaunayBoostVoronoi(points, triangles, error))
+    return false;
+  detail::canonicalize(triangles, points.size());
+  return true;
+}
+
+} // namespace
+
+namespace detail {
+
+bool
+delaunaySweep(const std::vector<QuantizedPoint>& points,
+              std::vector<Triangle>& triangles,
+              std::string* error)
+{
+  triangles.clear();
+  if (isStrictlySorted(points)) {
+    if (points.size() < 3 || allCollinear(points))
+      return true;
+    if (!triangulateSorted(points, triangles))
+      return triangulateByBoost(points, triangles, error);
+    canonicalize(triangles, points.size());
+    return true;
+  }
+  std::vector<std::uint64_t> keys;
+  const std::vector<index_t> order = sortedOrder(points, keys);
+  const auto duplicate = std::adjacent_find(keys.begin(), keys.end());
+  if (duplicate != keys.end()) {
+    reportDuplicate(points, points[order[duplicate - keys.begin()]], error);
+    return false;
+  }
+  std::vector<QuantizedPoint> sorted(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i)
+    sorted[i] = points[order[i]];
+  if (points.size() < 3 || allCollinear(sorted))
+    return true;
+  if (!triangulateSorted(sorted, triangles))
+    return triangulateByBoost(points, triangles, error);
+  for (auto& t : triangles)
+    for (auto& v : t)
+      v = order[v];
+  canonicalize(triangles, points.size());
+  return true;
+}
+
+} // namespace detail
+
+} // namespace selective_seg
+} // namespace pcl
