@@ -139,6 +139,10 @@ def main():
     memory.sort()
     write_plot(rows, a.plot)
     text = markdown(context, runs, rows, memory)
+    notes = os.path.join(os.path.dirname(a.markdown), "performance_notes.md")
+    if os.path.exists(notes):  # the hand-written analysis, kept across runs
+        with open(notes) as f:
+            text += "\n" + f.read()
     with open(a.markdown + ".tmp", "w") as f:
         f.write(text)
     os.replace(a.markdown + ".tmp", a.markdown)

@@ -105,7 +105,7 @@ printSegmentationHelp()
   print_info("  -angle_step_rad X      angle quantization step [rad] (default %g)\n",
              d.angle_quantization);
   print_info(
-      "  -backend NAME          Delaunay backend: boost or vtk (default boost)\n");
+      "  -backend NAME          Delaunay backend: sweep, boost or vtk (default sweep)\n");
 }
 
 bool
@@ -131,7 +131,9 @@ parseSegmentationOptions(int argc, char** argv, SelectiveSegmentationParameters&
           argc,
           argv,
           "-backend",
-          {{"boost", DelaunayBackend::BoostVoronoi}, {"vtk", DelaunayBackend::Vtk}},
+          {{"boost", DelaunayBackend::BoostVoronoi},
+                    {"vtk", DelaunayBackend::Vtk},
+                    {"sweep", DelaunayBackend::Sweep}},
           p.delaunay_backend))
     return false;
   std::string why;

@@ -83,7 +83,7 @@ public:
 
   SphericalDelaunay() { this->check_tree_ = false; }
 
-  /** \brief Triangulation backend (default: DelaunayBackend::BoostVoronoi). */
+  /** \brief Triangulation backend (default: DelaunayBackend::Sweep). */
   void setBackend(DelaunayBackend backend) { backend_ = backend; }
   DelaunayBackend getBackend() const { return backend_; }
 
@@ -153,7 +153,7 @@ protected:
   void toPolygons(std::vector<pcl::Vertices>& polygons) const;
 
 private:
-  DelaunayBackend backend_ = DelaunayBackend::BoostVoronoi;
+  DelaunayBackend backend_ = DelaunayBackend::Sweep;
   double angle_quantization_ = 1e-7;
   Eigen::Affine3f sensor_pose_ = Eigen::Affine3f::Identity();
   bool has_sensor_pose_ = false;
