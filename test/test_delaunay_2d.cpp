@@ -15,6 +15,7 @@
 #include <limits>
 #include <map>
 #include <numeric>
+#include <ostream>
 #include <random>
 #include <string>
 #include <utility>
@@ -568,6 +569,19 @@ TEST(DelaunayBackend, DuplicatePointsAreRejectedWithOneMessage)
     }
   }
 }
+
+namespace pcl {
+namespace selective_seg {
+
+/** Test lists name the backend parameter ("boost", "sweep"). */
+void
+PrintTo(DelaunayBackend backend, std::ostream* os)
+{
+  *os << toString(backend);
+}
+
+} // namespace selective_seg
+} // namespace pcl
 
 /** The exact backends: every exactness test runs on each of them. */
 class Delaunay2D : public ::testing::TestWithParam<DelaunayBackend> {};
