@@ -14,39 +14,47 @@
 namespace pcl {
 namespace selective_seg {
 
+namespace {
+
+/** Compressed incidence lists by a counting sort: groups_of(item, f) calls f(group)
+ * for each group of the item; each group lists its items in increasing order. */
+template <typename GroupsOf>
 Incidence
-Incidence::build(const std::vector<pcl::index_t>& group_of, std::size_t num_groups)
+buildIncidence(std::size_t num_items, std::size_t num_groups, GroupsOf groups_of)
 {
   Incidence inc;
   inc.offsets.assign(num_groups + 1, 0);
-  for (const auto g : group_of)
-    if (g >= 0)
-      ++inc.offsets[static_cast<std::size_t>(g) + 1];
+  for (std::size_t i = 0; i < num_items; ++i)
+    groups_of(i,
+              [&](pcl::index_t g) { ++inc.offsets[static_cast<std::size_t>(g) + 1]; });
   std::partial_sum(inc.offsets.begin(), inc.offsets.end(), inc.offsets.begin());
   inc.items.resize(inc.offsets.back());
   std::vector<std::size_t> next(inc.offsets.begin(), inc.offsets.end() - 1);
-  for (std::size_t i = 0; i < group_of.size(); ++i)
-    if (group_of[i] >= 0)
-      inc.items[next[static_cast<std::size_t>(group_of[i])]++] =
-          static_cast<pcl::index_t>(i);
+  for (std::size_t i = 0; i < num_items; ++i)
+    groups_of(i, [&](pcl::index_t g) {
+      inc.items[next[static_cast<std::size_t>(g)]++] = static_cast<pcl::index_t>(i);
+    });
   return inc;
+}
+
+} // namespace
+
+Incidence
+Incidence::build(const std::vector<pcl::index_t>& group_of, std::size_t num_groups)
+{
+  return buildIncidence(group_of.size(), num_groups, [&](std::size_t i, auto f) {
+    if (group_of[i] >= 0)
+      f(group_of[i]);
+  });
 }
 
 Incidence
 vertexTriangles(const std::vector<Triangle>& triangles, std::size_t num_vertices)
 {
-  Incidence inc;
-  inc.offsets.assign(num_vertices + 1, 0);
-  for (const auto& t : triangles)
-    for (const auto v : t)
-      ++inc.offsets[static_cast<std::size_t>(v) + 1];
-  std::partial_sum(inc.offsets.begin(), inc.offsets.end(), inc.offsets.begin());
-  inc.items.resize(inc.offsets.back());
-  std::vector<std::size_t> next(inc.offsets.begin(), inc.offsets.end() - 1);
-  for (std::size_t t = 0; t < triangles.size(); ++t)
+  return buildIncidence(triangles.size(), num_vertices, [&](std::size_t t, auto f) {
     for (const auto v : triangles[t])
-      inc.items[next[static_cast<std::size_t>(v)]++] = static_cast<pcl::index_t>(t);
-  return inc;
+      f(v);
+  });
 }
 
 namespace {
@@ -93,24 +101,13 @@ struct LeafTriangles {
   {
     const auto& tris = *in.triangles;
     triangle_leaves.resize(tris.size());
-    const std::size_t num_leaves = in.leaf_normals->size();
-    leaf_triangles.offsets.assign(num_leaves + 1, 0);
-    for (std::size_t t = 0; t < tris.size(); ++t) {
-      auto& leaves = triangle_leaves[t];
-      for (int i = 0; i < 3; ++i)
-        leaves[i] = (*in.vertex_leaf)[tris[t][i]];
-      forEachDistinct(leaves, [&](pcl::index_t l) { ++leaf_triangles.offsets[l + 1]; });
-    }
-    std::partial_sum(leaf_triangles.offsets.begin(),
-                     leaf_triangles.offsets.end(),
-                     leaf_triangles.offsets.begin());
-    leaf_triangles.items.resize(leaf_triangles.offsets.back());
-    std::vector<std::size_t> next(leaf_triangles.offsets.begin(),
-                                  leaf_triangles.offsets.end() - 1);
     for (std::size_t t = 0; t < tris.size(); ++t)
-      forEachDistinct(triangle_leaves[t], [&](pcl::index_t l) {
-        leaf_triangles.items[next[l]++] = static_cast<pcl::index_t>(t);
-      });
+      for (int i = 0; i < 3; ++i)
+        triangle_leaves[t][i] = (*in.vertex_leaf)[tris[t][i]];
+    leaf_triangles = buildIncidence(
+        tris.size(), in.leaf_normals->size(), [&](std::size_t t, auto f) {
+          forEachDistinct(triangle_leaves[t], f);
+        });
   }
 
   /** Call f once for each distinct non-negative leaf of a triangle. */
