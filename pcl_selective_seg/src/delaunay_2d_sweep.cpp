@@ -224,6 +224,7 @@ private:
   index_t locate(index_t p);
   void closeNotchesAbove(index_t p);
   bool closeNotchBelow(index_t p, bool sharp_only);
+  void closeNotch(index_t left, index_t middle, index_t right);
   void convexifyFront();
   void removeVertex(index_t v);
   void flipSpokesAway(index_t v, index_t boundary_spoke);
@@ -384,17 +385,25 @@ SweepTriangulation::closeNotchesAbove(index_t p)
     const index_t c = front_next_[b];
     if (c == kNone || !isSharpNotch(points_[p], points_[b], points_[c]))
       return;
-    const index_t e = addTriangle(p, c, b);
-    twins_[e] = kNone;
-    link(e + 1, boundary_edge_[b]);
-    link(e + 2, boundary_edge_[p]);
-    boundary_edge_[p] = e;
-    front_next_[b] = front_previous_[b] = kNone;
-    joinFront(p, c);
-    stack_.push_back(e + 1);
-    stack_.push_back(e + 2);
-    legalize();
+    closeNotch(p, b, c);
   }
+}
+
+/** Closes the front notch left -> middle -> right by the triangle (left, right,
+ * middle): \a middle leaves the front, and the new edges are legalized. */
+void
+SweepTriangulation::closeNotch(index_t left, index_t middle, index_t right)
+{
+  const index_t e = addTriangle(left, right, middle);
+  twins_[e] = kNone;
+  link(e + 1, boundary_edge_[middle]);
+  link(e + 2, boundary_edge_[left]);
+  boundary_edge_[left] = e;
+  front_next_[middle] = front_previous_[middle] = kNone;
+  joinFront(left, right);
+  stack_.push_back(e + 1);
+  stack_.push_back(e + 2);
+  legalize();
 }
 
 /** Closes the notch below \a p, z -> a -> p (a right turn; if \a sharp_only, a sharp
@@ -410,16 +419,7 @@ SweepTriangulation::closeNotchBelow(index_t p, bool sharp_only)
                                 : orientation(points_[z], points_[a], points_[p]) < 0;
   if (!notch)
     return false;
-  const index_t e = addTriangle(z, p, a);
-  twins_[e] = kNone;
-  link(e + 1, boundary_edge_[a]);
-  link(e + 2, boundary_edge_[z]);
-  boundary_edge_[z] = e;
-  front_next_[a] = front_previous_[a] = kNone;
-  joinFront(z, p);
-  stack_.push_back(e + 1);
-  stack_.push_back(e + 2);
-  legalize();
+  closeNotch(z, a, p);
   return true;
 }
 
