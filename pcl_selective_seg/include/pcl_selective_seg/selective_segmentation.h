@@ -124,6 +124,21 @@ public:
    *         unusable input or an invalid parameter. */
   bool extract(std::vector<pcl::PointIndices>& clusters);
 
+  /** \brief Fold more points of the same scene, seen from the same sensor pose, into
+   * the result of the last successful extract() or update() (selective sensing: a
+   * finer scan of some regions of interest).
+   *
+   * The input becomes a new cloud: the previous input followed by \a new_points
+   * (given in the same frame as the input; unorganized, height 1). With indices set,
+   * the new points' indices are appended to them. The finest voxel size of the run
+   * being updated is kept, so the result is that of extract() on the union with
+   * setMinVoxelSize(getResult().min_voxel_size) (see docs/selective_sensing.md for
+   * what is recomputed and how closely it matches).
+   * \param[in] new_points the points to add
+   * \param[out] clusters as extract(), over the union
+   * \return as extract(); false also when there is no result to update. */
+  bool update(const PointCloud& new_points, std::vector<pcl::PointIndices>& clusters);
+
   /** \brief Labels, segments, leaves, mesh, counts and timings of the last extract().
    */
   const SegmentationResult& getResult() const { return result_; }

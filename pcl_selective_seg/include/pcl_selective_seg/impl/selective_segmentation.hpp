@@ -388,6 +388,45 @@ SelectiveSegmentation<PointT>::extract(std::vector<pcl::PointIndices>& clusters)
 }
 
 template <typename PointT>
+bool
+SelectiveSegmentation<PointT>::update(const PointCloud& new_points,
+                                      std::vector<pcl::PointIndices>& clusters)
+{
+  clusters.clear();
+  if (!input_ || result_.segments.empty() || result_.labels.size() != input_->size()) {
+    PCL_ERROR("[pcl::selective_seg::%s::update] no result to update: call extract() "
+              "first\n",
+              getClassName().c_str());
+    return false;
+  }
+  auto merged = pcl::make_shared<PointCloud>();
+  merged->reserve(input_->size() + new_points.size());
+  merged->points.insert(merged->end(), input_->begin(), input_->end());
+  merged->points.insert(merged->end(), new_points.begin(), new_points.end());
+  merged->width = static_cast<std::uint32_t>(merged->points.size());
+  merged->height = 1;
+  merged->is_dense = input_->is_dense && new_points.is_dense;
+  merged->header = input_->header;
+  merged->sensor_origin_ = input_->sensor_origin_;
+  merged->sensor_orientation_ = input_->sensor_orientation_;
+  if (!this->fake_indices_ && indices_) {
+    auto indices = pcl::make_shared<pcl::Indices>(*indices_);
+    for (std::size_t i = 0; i < new_points.size(); ++i)
+      indices->push_back(static_cast<pcl::index_t>(input_->size() + i));
+    this->setInputCloud(merged);
+    this->setIndices(indices);
+  }
+  else
+    this->setInputCloud(merged);
+  const SelectiveSegmentationParameters saved = params_;
+  if (!(params_.min_voxel_size > 0.0))
+    params_.min_voxel_size = result_.min_voxel_size;
+  const bool ok = extract(clusters);
+  params_ = saved;
+  return ok;
+}
+
+template <typename PointT>
 typename SelectiveSegmentation<PointT>::LabeledCloud::Ptr
 SelectiveSegmentation<PointT>::getLabeledCloud() const
 {
