@@ -1,0 +1,533 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
+ */
+
+// Insertion of points into an exact Delaunay triangulation by local re-triangulation.
+//
+// Let P be the old points, Q the new ones, U = P + Q. An old triangle survives in DT(U)
+// unless a new point lies in its closed circumdisk (then it is "replaced": a new point
+// inside breaks the empty-circle property, one on the circle joins a co-circular
+// group whose canonical fan may change). The replaced triangles C, plus the area the
+// convex hull gains, form the region R; the kept triangles K tile the rest. Every
+// triangle of DT(U) inside R has its vertices among Q, the vertices of C and the hull
+// vertices that the new points see, and is empty in U, hence Delaunay (with the same
+// canonical split) in any subset L of U that holds those points. So R is re-tiled by
+// the triangles of DT(L) found by a flood from the new points' triangles that stops
+// at the boundary of K. The result is checked (every boundary edge of K matched once,
+// Euler's count over the whole mesh) before it replaces the input.
+
+#include <pcl_selective_seg/delaunay_2d_update.h>
+
+#include "delaunay_2d_backends.h"
+
+#include <algorithm>
+#include <cstdint>
+#include <unordered_map>
+
+namespace pcl {
+namespace selective_seg {
+
+namespace {
+
+using detail::inCircle;
+using detail::orientation;
+
+/** Undirected edge key over new point ids. */
+inline std::uint64_t
+edgeKey(pcl::index_t a, pcl::index_t b)
+{
+  if (a > b)
+    std::swap(a, b);
+  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) |
+         static_cast<std::uint32_t>(b);
+}
+
+/** A hull edge: triangle and the local index of the vertex opposite the edge. The edge
+ * runs from triangle[(i + 1) % 3] to triangle[(i + 2) % 3], the interior on its left.
+ */
+struct HullEdge {
+  pcl::index_t triangle = -1;
+  int opposite = 0;
+};
+
+int
+localIndex(const Triangle& t, pcl::index_t v)
+{
+  return t[0] == v ? 0 : (t[1] == v ? 1 : 2);
+}
+
+class Inserter {
+public:
+  Inserter(const std::vector<QuantizedPoint>& points,
+           const std::vector<Triangle>& triangles,
+           const std::vector<Triangle>& neighbours)
+  : p_(points), t_(triangles), n_(neighbours)
+  {}
+
+  bool run(const std::vector<QuantizedPoint>& q,
+           std::vector<QuantizedPoint>& out_points,
+           std::vector<Triangle>& out_triangles,
+           std::vector<Triangle>& out_neighbours,
+           DelaunayInsertion& info,
+           std::string* error);
+
+private:
+  /** Walk from \a start to the triangle holding \a q; false: q is outside the hull
+   * and \a exit is the hull edge the walk left through. */
+  bool locate(const QuantizedPoint& q, pcl::index_t& start, HullEdge& exit) const;
+
+  HullEdge nextHullEdge(HullEdge h) const;
+  HullEdge previousHullEdge(HullEdge h) const;
+
+  bool visible(const HullEdge& h, const QuantizedPoint& q) const
+  {
+    const Triangle& tri = t_[h.triangle];
+    return orientation(p_[tri[(h.opposite + 1) % 3]], p_[tri[(h.opposite + 2) % 3]], q) <
+           0;
+  }
+
+  bool inConflict(pcl::index_t t, const QuantizedPoint& q) const
+  {
+    const Triangle& tri = t_[t];
+    return inCircle(p_[tri[0]], p_[tri[1]], p_[tri[2]], q) >= 0;
+  }
+
+  /** Add every triangle whose closed circumdisk holds q, connected to \a seed. */
+  void collectConflicts(pcl::index_t seed, const QuantizedPoint& q, std::uint32_t stamp);
+
+  const std::vector<QuantizedPoint>& p_;
+  const std::vector<Triangle>& t_;
+  const std::vector<Triangle>& n_;
+  std::vector<std::uint8_t> replaced_;  // per old triangle
+  std::vector<std::uint32_t> visited_;  // per old triangle: stamp of the last new point
+  std::vector<pcl::index_t> conflicts_; // replaced triangles
+  std::vector<HullEdge> seen_hull_;     // old hull edges visible from a new point
+  std::vector<pcl::index_t> stack_;
+};
+
+bool
+Inserter::locate(const QuantizedPoint& q, pcl::index_t& start, HullEdge& exit) const
+{
+  pcl::index_t t = start;
+  const std::size_t limit = 4 * t_.size() + 16;
+  for (std::size_t step = 0; step < limit; ++step) {
+    const Triangle& tri = t_[t];
+    int out = -1;
+    for (int k = 0; k < 3 && out < 0; ++k) {
+      const int i = static_cast<int>((k + step) % 3); // vary the first edge tried
+      if (orientation(p_[tri[(i + 1) % 3]], p_[tri[(i + 2) % 3]], q) < 0)
+        out = i;
+    }
+    if (out < 0) {
+      start = t;
+      return true;
+    }
+    if (n_[t][out] < 0) {
+      start = t;
+      exit = {t, out};
+      return false;
+    }
+    t = n_[t][out];
+  }
+  exit = {-1, 0};
+  return false;
+}
+
+HullEdge
+Inserter::nextHullEdge(HullEdge h) const
+{
+  // Rotate around the edge's end vertex, through the interior, to the next hull edge.
+  const pcl::index_t end = t_[h.triangle][(h.opposite + 2) % 3];
+  pcl::index_t cur = h.triangle;
+  int j = (h.opposite + 2) % 3;
+  for (std::size_t guard = 0; guard <= t_.size(); ++guard) {
+    const int opp = (j + 2) % 3; // the edge leaving `end` in cur
+    const pcl::index_t next = n_[cur][opp];
+    if (next < 0)
+      return {cur, opp};
+    cur = next;
+    j = localIndex(t_[cur], end);
+  }
+  return {-1, 0};
+}
+
+HullEdge
+Inserter::previousHullEdge(HullEdge h) const
+{
+  const pcl::index_t begin = t_[h.triangle][(h.opposite + 1) % 3];
+  pcl::index_t cur = h.triangle;
+  int j = (h.opposite + 1) % 3;
+  for (std::size_t guard = 0; guard <= t_.size(); ++guard) {
+    const int opp = (j + 1) % 3; // the edge arriving at `begin` in cur
+    const pcl::index_t next = n_[cur][opp];
+    if (next < 0)
+      return {cur, opp};
+    cur = next;
+    j = localIndex(t_[cur], begin);
+  }
+  return {-1, 0};
+}
+
+void
+Inserter::collectConflicts(pcl::index_t seed, const QuantizedPoint& q, std::uint32_t stamp)
+{
+  if (visited_[seed] == stamp)
+    return;
+  visited_[seed] = stamp;
+  stack_.assign(1, seed);
+  while (!stack_.empty()) {
+    const pcl::index_t t = stack_.back();
+    stack_.pop_back();
+    if (!replaced_[t]) {
+      replaced_[t] = 1;
+      conflicts_.push_back(t);
+    }
+    for (const pcl::index_t u : n_[t])
+      if (u >= 0 && visited_[u] != stamp) {
+        visited_[u] = stamp;
+        if (inConflict(u, q))
+          stack_.push_back(u);
+      }
+  }
+}
+
+bool
+Inserter::run(const std::vector<QuantizedPoint>& q,
+              std::vector<QuantizedPoint>& out_points,
+              std::vector<Triangle>& out_triangles,
+              std::vector<Triangle>& out_neighbours,
+              DelaunayInsertion& info,
+              std::string* error)
+{
+  const std::size_t num_old = t_.size();
+  replaced_.assign(num_old, 0);
+  visited_.assign(num_old, 0);
+  std::vector<pcl::index_t> chain; // old hull vertices seen from new points
+
+  // 1. Locate the new points (sorted: consecutive walks are short) and collect the
+  // replaced triangles and the hull edges the new points see.
+  pcl::index_t hint = 0;
+  for (std::size_t k = 0; k < q.size(); ++k) {
+    const auto stamp = static_cast<std::uint32_t>(k + 1);
+    HullEdge exit;
+    if (locate(q[k], hint, exit)) {
+      collectConflicts(hint, q[k], stamp);
+      continue;
+    }
+    if (exit.triangle < 0) {
+      detail::setError(error, "insertDelaunayPoints: point location did not terminate");
+      return false;
+    }
+    // Outside the hull: the chain of hull edges visible from q, both ways from exit.
+    const auto visit = [&](const HullEdge& h) {
+      seen_hull_.push_back(h);
+      const Triangle& tri = t_[h.triangle];
+      chain.push_back(tri[(h.opposite + 1) % 3]);
+      chain.push_back(tri[(h.opposite + 2) % 3]);
+      if (visited_[h.triangle] != stamp && inConflict(h.triangle, q[k]))
+        collectConflicts(h.triangle, q[k], stamp);
+    };
+    visit(exit);
+    std::size_t guard = 0;
+    for (HullEdge h = nextHullEdge(exit);
+         h.triangle >= 0 && visible(h, q[k]) && guard <= num_old;
+         h = nextHullEdge(h), ++guard)
+      visit(h);
+    for (HullEdge h = previousHullEdge(exit);
+         h.triangle >= 0 && visible(h, q[k]) && guard <= 2 * num_old + 1;
+         h = previousHullEdge(h), ++guard)
+      visit(h);
+  }
+
+  // 2. The new numbering: the union in lexicographic order.
+  info.old_to_new_point.resize(p_.size());
+  info.inserted_points.resize(q.size());
+  out_points.clear();
+  out_points.reserve(p_.size() + q.size());
+  for (std::size_t i = 0, j = 0; i < p_.size() || j < q.size();) {
+    const auto id = static_cast<pcl::index_t>(out_points.size());
+    if (j == q.size() || (i < p_.size() && p_[i] < q[j])) {
+      info.old_to_new_point[i] = id;
+      out_points.push_back(p_[i++]);
+    }
+    else {
+      info.inserted_points[j] = id;
+      out_points.push_back(q[j++]);
+    }
+  }
+  const auto& remap = info.old_to_new_point;
+
+  // 3. The boundary of the kept triangles around the region: edges between a kept and
+  // a replaced triangle, and old hull edges of kept triangles that new points see.
+  struct Boundary {
+    std::uint64_t key;
+    pcl::index_t kept; // old id of the kept triangle
+  };
+  std::vector<Boundary> boundary;
+  std::vector<pcl::index_t> local; // new ids of the local points
+  for (const pcl::index_t t : conflicts_) {
+    for (int i = 0; i < 3; ++i) {
+      local.push_back(remap[t_[t][i]]);
+      const pcl::index_t u = n_[t][i];
+      if (u < 0 || replaced_[u])
+        continue;
+      for (const pcl::index_t v : t_[u]) // one ring more around the region
+        local.push_back(remap[v]);
+      boundary.push_back(
+          {edgeKey(remap[t_[t][(i + 1) % 3]], remap[t_[t][(i + 2) % 3]]), u});
+    }
+  }
+  for (const HullEdge& h : seen_hull_)
+    if (!replaced_[h.triangle]) {
+      const Triangle& tri = t_[h.triangle];
+      boundary.push_back({edgeKey(remap[tri[(h.opposite + 1) % 3]],
+                                  remap[tri[(h.opposite + 2) % 3]]),
+                          h.triangle});
+    }
+  for (const pcl::index_t v : chain)
+    local.push_back(remap[v]);
+  local.insert(local.end(), info.inserted_points.begin(), info.inserted_points.end());
+  std::sort(local.begin(), local.end());
+  local.erase(std::unique(local.begin(), local.end()), local.end());
+  std::sort(boundary.begin(), boundary.end(), [](const Boundary& a, const Boundary& b) {
+    return a.key < b.key;
+  });
+  boundary.erase(std::unique(boundary.begin(),
+                             boundary.end(),
+                             [](const Boundary& a, const Boundary& b) {
+                               return a.key == b.key;
+                             }),
+                 boundary.end());
+  const auto findBoundary = [&](std::uint64_t key) -> const Boundary* {
+    const auto it = std::lower_bound(
+        boundary.begin(), boundary.end(), key, [](const Boundary& b, std::uint64_t k) {
+          return b.key < k;
+        });
+    return it != boundary.end() && it->key == key ? &*it : nullptr;
+  };
+
+  // 4. The local triangulation (its points are sorted: the sweep's fast path), and the
+  // flood from the triangles at new points, stopped by the boundary.
+  std::vector<QuantizedPoint> local_points(local.size());
+  for (std::size_t i = 0; i < local.size(); ++i)
+    local_points[i] = out_points[local[i]];
+  std::vector<Triangle> local_tris, local_nbrs;
+  if (!detail::delaunaySweep(local_points, local_tris, error))
+    return false;
+  computeTriangleNeighbours(local_tris, local.size(), local_nbrs);
+  std::vector<std::uint8_t> is_new_point(local.size(), 0);
+  for (std::size_t i = 0, j = 0; i < local.size(); ++i) {
+    while (j < info.inserted_points.size() && info.inserted_points[j] < local[i])
+      ++j;
+    is_new_point[i] =
+        j < info.inserted_points.size() && info.inserted_points[j] == local[i];
+  }
+  std::vector<std::uint8_t> in_region(local_tris.size(), 0);
+  stack_.clear();
+  for (std::size_t t = 0; t < local_tris.size(); ++t)
+    if (is_new_point[local_tris[t][0]] || is_new_point[local_tris[t][1]] ||
+        is_new_point[local_tris[t][2]]) {
+      in_region[t] = 1;
+      stack_.push_back(static_cast<pcl::index_t>(t));
+    }
+  std::vector<std::uint8_t> matched(boundary.size(), 0);
+  while (!stack_.empty()) {
+    const pcl::index_t t = stack_.back();
+    stack_.pop_back();
+    for (int i = 0; i < 3; ++i) {
+      const pcl::index_t u = local_nbrs[t][i];
+      if (u < 0 || in_region[u])
+        continue;
+      if (findBoundary(edgeKey(local[local_tris[t][(i + 1) % 3]],
+                               local[local_tris[t][(i + 2) % 3]])))
+        continue;
+      in_region[u] = 1;
+      stack_.push_back(u);
+    }
+  }
+
+  // 5. Assemble: kept triangles renumbered (still in canonical order, since the
+  // renumbering keeps the order of the points) merged with the region's triangles
+  // (canonical in local ids, and local ids increase with new ids).
+  std::vector<Triangle> fresh;
+  std::vector<pcl::index_t> fresh_local;
+  for (std::size_t t = 0; t < local_tris.size(); ++t)
+    if (in_region[t]) {
+      const Triangle& lt = local_tris[t];
+      fresh.push_back({local[lt[0]], local[lt[1]], local[lt[2]]});
+      fresh_local.push_back(static_cast<pcl::index_t>(t));
+    }
+  const std::size_t num_kept = num_old - conflicts_.size();
+  const std::size_t total = num_kept + fresh.size();
+  out_triangles.clear();
+  out_triangles.reserve(total);
+  info.old_to_new_triangle.assign(num_old, -1);
+  info.new_triangles.clear();
+  std::vector<pcl::index_t> local_to_new(local_tris.size(), -1);
+  {
+    std::size_t i = 0, j = 0;
+    Triangle kept_tri{};
+    const auto keptAt = [&](std::size_t k) {
+      const Triangle& o = t_[k];
+      return Triangle{remap[o[0]], remap[o[1]], remap[o[2]]};
+    };
+    while (i < num_old && replaced_[i])
+      ++i;
+    if (i < num_old)
+      kept_tri = keptAt(i);
+    while (i < num_old || j < fresh.size()) {
+      const auto id = static_cast<pcl::index_t>(out_triangles.size());
+      if (j == fresh.size() || (i < num_old && kept_tri < fresh[j])) {
+        info.old_to_new_triangle[i] = id;
+        out_triangles.push_back(kept_tri);
+        ++i;
+        while (i < num_old && replaced_[i])
+          ++i;
+        if (i < num_old)
+          kept_tri = keptAt(i);
+      }
+      else {
+        local_to_new[fresh_local[j]] = id;
+        info.new_triangles.push_back(id);
+        out_triangles.push_back(fresh[j++]);
+      }
+    }
+  }
+
+  // 6. Adjacency: kept pairs renumbered; across the boundary through the edge keys.
+  std::unordered_map<std::uint64_t, pcl::index_t> fresh_edges; // region side
+  for (std::size_t j = 0; j < fresh.size(); ++j) {
+    const pcl::index_t lt = fresh_local[j];
+    for (int i = 0; i < 3; ++i) {
+      const pcl::index_t u = local_nbrs[lt][i];
+      if (u >= 0 && in_region[u])
+        continue;
+      const std::uint64_t key = edgeKey(fresh[j][(i + 1) % 3], fresh[j][(i + 2) % 3]);
+      if (const Boundary* b = findBoundary(key)) {
+        const auto index = static_cast<std::size_t>(b - boundary.data());
+        if (matched[index]++) {
+          detail::setError(error, "insertDelaunayPoints: a boundary edge is matched "
+                                  "twice");
+          return false;
+        }
+        fresh_edges.emplace(key, local_to_new[lt]);
+      }
+    }
+  }
+  if (std::find(matched.begin(), matched.end(), 0) != matched.end()) {
+    detail::setError(error, "insertDelaunayPoints: the re-triangulated region does not "
+                            "meet the kept triangles");
+    return false;
+  }
+  out_neighbours.assign(total, Triangle{-1, -1, -1});
+  std::size_t hull_edges = 0;
+  for (std::size_t k = 0; k < num_old; ++k) {
+    const pcl::index_t id = info.old_to_new_triangle[k];
+    if (id < 0)
+      continue;
+    for (int i = 0; i < 3; ++i) {
+      const pcl::index_t u = n_[k][i];
+      if (u >= 0 && !replaced_[u]) {
+        out_neighbours[id][i] = info.old_to_new_triangle[u];
+        continue;
+      }
+      const Triangle& tri = out_triangles[id];
+      const auto it = fresh_edges.find(edgeKey(tri[(i + 1) % 3], tri[(i + 2) % 3]));
+      if (it != fresh_edges.end())
+        out_neighbours[id][i] = it->second;
+      else
+        ++hull_edges;
+    }
+  }
+  for (std::size_t j = 0; j < fresh.size(); ++j) {
+    const pcl::index_t lt = fresh_local[j];
+    const pcl::index_t id = local_to_new[lt];
+    for (int i = 0; i < 3; ++i) {
+      const pcl::index_t u = local_nbrs[lt][i];
+      if (u >= 0 && in_region[u]) {
+        out_neighbours[id][i] = local_to_new[u];
+        continue;
+      }
+      const Boundary* b =
+          findBoundary(edgeKey(fresh[j][(i + 1) % 3], fresh[j][(i + 2) % 3]));
+      if (b)
+        out_neighbours[id][i] = info.old_to_new_triangle[b->kept];
+      else
+        ++hull_edges;
+    }
+  }
+  // Euler: a triangulation of V points with h of them on its boundary has 2V - h - 2
+  // triangles (every point a vertex, as in any Delaunay triangulation).
+  if (2 * out_points.size() < hull_edges + 2 ||
+      total != 2 * out_points.size() - hull_edges - 2) {
+    detail::setError(error, "insertDelaunayPoints: the stitched mesh fails Euler's "
+                            "count");
+    return false;
+  }
+  info.replaced_triangles = conflicts_.size();
+  info.local_points = local.size();
+  return true;
+}
+
+} // namespace
+
+bool
+insertDelaunayPoints(std::vector<QuantizedPoint>& points,
+                     std::vector<Triangle>& triangles,
+                     std::vector<Triangle>& neighbours,
+                     std::vector<QuantizedPoint> new_points,
+                     DelaunayInsertion& info,
+                     std::string* error)
+{
+  info = DelaunayInsertion();
+  const auto inRange = [](const QuantizedPoint& p) {
+    return std::abs(p[0]) <= kMaxDelaunayCoordinate &&
+           std::abs(p[1]) <= kMaxDelaunayCoordinate;
+  };
+  if (triangles.empty() || neighbours.size() != triangles.size()) {
+    detail::setError(error,
+                     "insertDelaunayPoints: the old triangulation has no triangles");
+    return false;
+  }
+  for (std::size_t i = 1; i < points.size(); ++i)
+    if (!(points[i - 1] < points[i])) {
+      detail::setError(error,
+                       "insertDelaunayPoints: the old points are not sorted and distinct");
+      return false;
+    }
+  std::sort(new_points.begin(), new_points.end());
+  for (std::size_t i = 0; i < new_points.size(); ++i) {
+    if (!inRange(new_points[i]) || (i > 0 && new_points[i - 1] == new_points[i]) ||
+        std::binary_search(points.begin(), points.end(), new_points[i])) {
+      detail::setError(error,
+                       "insertDelaunayPoints: a new point is out of range, repeated or "
+                       "already in the triangulation");
+      return false;
+    }
+  }
+  if (new_points.empty()) {
+    info.old_to_new_point.resize(points.size());
+    for (std::size_t i = 0; i < points.size(); ++i)
+      info.old_to_new_point[i] = static_cast<pcl::index_t>(i);
+    info.old_to_new_triangle.resize(triangles.size());
+    for (std::size_t i = 0; i < triangles.size(); ++i)
+      info.old_to_new_triangle[i] = static_cast<pcl::index_t>(i);
+    return true;
+  }
+  std::vector<QuantizedPoint> out_points;
+  std::vector<Triangle> out_triangles, out_neighbours;
+  Inserter inserter(points, triangles, neighbours);
+  if (!inserter.run(new_points, out_points, out_triangles, out_neighbours, info, error)) {
+    info = DelaunayInsertion();
+    return false;
+  }
+  points.swap(out_points);
+  triangles.swap(out_triangles);
+  neighbours.swap(out_neighbours);
+  return true;
+}
+
+} // namespace selective_seg
+} // namespace pcl
