@@ -5,57 +5,307 @@
  */
 
 // SelectiveSegmentation::update(): folding a finer scan into an existing result must
-// give the result of a from-scratch run on the union of the points.
+// give exactly the result of a from-scratch run on the union of the points (with the
+// finest voxel size of the run being updated), while recomputing the mesh and its
+// normals only where the new points fall.
 
 #include <pcl_selective_seg/selective_segmentation.h>
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <random>
+
 #include <cube_scene.h>
 
 using pcl::selective_seg::SelectiveSegmentation;
 using Cloud = pcl::PointCloud<pcl::PointXYZ>;
+using Seg = SelectiveSegmentation<pcl::PointXYZ>;
 
 namespace {
 
 Cloud::Ptr
-toXYZ(const pcl::PointCloud<pcl::PointXYZL>& in, std::size_t begin, std::size_t end)
+toXYZ(const pcl::PointCloud<pcl::PointXYZL>& in)
 {
   auto out = pcl::make_shared<Cloud>();
-  for (std::size_t i = begin; i < end; ++i)
-    out->push_back(pcl::PointXYZ(in[i].x, in[i].y, in[i].z));
+  for (const auto& p : in)
+    out->push_back(pcl::PointXYZ(p.x, p.y, p.z));
+  return out;
+}
+
+Cloud::Ptr
+slice(const Cloud& in, std::size_t begin, std::size_t end)
+{
+  auto out = pcl::make_shared<Cloud>();
+  out->points.assign(in.begin() + begin, in.begin() + end);
+  out->width = static_cast<std::uint32_t>(out->size());
+  out->height = 1;
+  return out;
+}
+
+/** Points of \a scan whose viewing direction lies in the window (sensor at origin). */
+Cloud::Ptr
+window(const Cloud& scan, double theta0, double theta1, double phi0, double phi1)
+{
+  auto out = pcl::make_shared<Cloud>();
+  for (const auto& p : scan) {
+    const double theta = std::atan2(p.x, p.z), phi = std::atan2(p.y, p.z);
+    if (theta >= theta0 && theta <= theta1 && phi >= phi0 && phi <= phi1)
+      out->push_back(p);
+  }
+  return out;
+}
+
+bool
+sameFloat(float a, float b)
+{
+  return (std::isnan(a) && std::isnan(b)) || a == b;
+}
+
+/** Every output of \a seg equals the reference run's, bit for bit. */
+void
+expectSameResult(const Seg& seg, const Seg& ref)
+{
+  const auto& a = seg.getResult();
+  const auto& b = ref.getResult();
+  EXPECT_EQ(a.labels, b.labels);
+  ASSERT_EQ(a.segments.size(), b.segments.size());
+  for (std::size_t s = 0; s < a.segments.size(); ++s) {
+    EXPECT_EQ(a.segments[s].num_points, b.segments[s].num_points);
+    EXPECT_EQ(a.segments[s].normal, b.segments[s].normal);
+    EXPECT_EQ(a.segments[s].area, b.segments[s].area);
+  }
+  ASSERT_EQ(a.leaves.size(), b.leaves.size());
+  for (std::size_t l = 0; l < a.leaves.size(); ++l) {
+    EXPECT_EQ(a.leaves[l].centre, b.leaves[l].centre);
+    EXPECT_EQ(a.leaves[l].label, b.leaves[l].label);
+    EXPECT_EQ(a.leaves[l].area, b.leaves[l].area);
+  }
+  EXPECT_EQ(a.mesh.triangles, b.mesh.triangles);
+  EXPECT_EQ(a.mesh.neighbours, b.mesh.neighbours);
+  EXPECT_EQ(a.mesh.labels, b.mesh.labels);
+  EXPECT_EQ(a.mesh.classes, b.mesh.classes);
+  EXPECT_EQ(a.mesh.areas, b.mesh.areas);
+  EXPECT_EQ(a.num_vertices, b.num_vertices);
+  EXPECT_EQ(a.median_spacing, b.median_spacing);
+  EXPECT_EQ(a.min_voxel_size, b.min_voxel_size);
+  EXPECT_EQ(a.counts.labeled, b.counts.labeled);
+  EXPECT_EQ(a.counts.non_finite, b.counts.non_finite);
+  EXPECT_EQ(a.counts.behind_sensor, b.counts.behind_sensor);
+  EXPECT_EQ(a.counts.outside_indices, b.counts.outside_indices);
+  EXPECT_EQ(a.counts.shared_vertex, b.counts.shared_vertex);
+  const auto& ta = seg.getTriangulation();
+  const auto& tb = ref.getTriangulation();
+  EXPECT_EQ(ta.point_vertex, tb.point_vertex);
+  EXPECT_EQ(ta.vertex_point, tb.vertex_point);
+  const auto na = seg.getPointNormals();
+  const auto nb = ref.getPointNormals();
+  ASSERT_TRUE(na && nb);
+  ASSERT_EQ(na->size(), nb->size());
+  std::size_t different = 0;
+  for (std::size_t i = 0; i < na->size(); ++i)
+    for (int k = 0; k < 3; ++k)
+      different += !sameFloat((*na)[i].normal[k], (*nb)[i].normal[k]);
+  EXPECT_EQ(different, 0u);
+}
+
+/** A from-scratch run on the union with the same finest voxel. */
+void
+reference(const Cloud::Ptr& all, double voxel, Seg& ref)
+{
+  ref.setInputCloud(all);
+  ref.setMinVoxelSize(voxel);
+  std::vector<pcl::PointIndices> clusters;
+  ASSERT_TRUE(ref.extract(clusters));
+}
+
+Cloud::Ptr
+concat(const Cloud& a, const Cloud& b)
+{
+  auto out = pcl::make_shared<Cloud>(a);
+  *out += b;
   return out;
 }
 
 } // namespace
 
-TEST(SelectiveSegmentationUpdate, EqualsExtractOnTheUnionWithTheSameVoxelSize)
+TEST(SelectiveSegmentationUpdate, RandomFifthOfTheScanEqualsExtractOnTheUnion)
 {
-  const auto scan = selseg_test::cubeScan(6000, 7);
-  ASSERT_GT(scan->size(), 5000u);
+  auto scan = toXYZ(*selseg_test::cubeScan(6000, 7));
+  std::mt19937 rng(1);
+  std::shuffle(scan->begin(), scan->end(), rng);
   const std::size_t split = scan->size() * 4 / 5;
-  SelectiveSegmentation<pcl::PointXYZ> seg;
-  seg.setInputCloud(toXYZ(*scan, 0, split));
+  Seg seg;
+  seg.setInputCloud(slice(*scan, 0, split));
   std::vector<pcl::PointIndices> clusters;
   ASSERT_TRUE(seg.extract(clusters));
   const double voxel = seg.getResult().min_voxel_size;
-  ASSERT_TRUE(seg.update(*toXYZ(*scan, split, scan->size()), clusters));
+  ASSERT_TRUE(seg.update(*slice(*scan, split, scan->size()), clusters));
+  EXPECT_TRUE(seg.getUpdateStatistics().incremental);
+  EXPECT_EQ(seg.getUpdateStatistics().new_points, scan->size() - split);
   EXPECT_EQ(seg.getResult().labels.size(), scan->size());
   EXPECT_EQ(seg.getResult().min_voxel_size, voxel);
-
-  SelectiveSegmentation<pcl::PointXYZ> ref;
-  ref.setInputCloud(toXYZ(*scan, 0, scan->size()));
-  ref.setMinVoxelSize(voxel);
+  Seg ref;
+  reference(concat(*slice(*scan, 0, split), *slice(*scan, split, scan->size())),
+            voxel,
+            ref);
+  expectSameResult(seg, ref);
   std::vector<pcl::PointIndices> ref_clusters;
-  ASSERT_TRUE(ref.extract(ref_clusters));
-  EXPECT_EQ(seg.getResult().labels, ref.getResult().labels);
-  EXPECT_EQ(clusters.size(), ref_clusters.size());
+  EXPECT_EQ(clusters.size(), ref.getResult().segments.size());
+}
+
+TEST(SelectiveSegmentationUpdate, FinerScanOfAWindowChangesOnlyItsRegion)
+{
+  const auto coarse = toXYZ(*selseg_test::cubeScan(5000, 11));
+  const auto fine_all = toXYZ(*selseg_test::cubeScan(40000, 12));
+  // A window over a fifth of the view's width and height, off centre.
+  double t0 = 1e9, t1 = -1e9, p0 = 1e9, p1 = -1e9;
+  for (const auto& p : *coarse) {
+    t0 = std::min(t0, std::atan2(double(p.x), double(p.z)));
+    t1 = std::max(t1, std::atan2(double(p.x), double(p.z)));
+    p0 = std::min(p0, std::atan2(double(p.y), double(p.z)));
+    p1 = std::max(p1, std::atan2(double(p.y), double(p.z)));
+  }
+  const auto fine = window(*fine_all,
+                           t0 + 0.45 * (t1 - t0),
+                           t0 + 0.65 * (t1 - t0),
+                           p0 + 0.35 * (p1 - p0),
+                           p0 + 0.55 * (p1 - p0));
+  ASSERT_GT(fine->size(), 500u);
+  Seg seg;
+  seg.setInputCloud(coarse);
+  std::vector<pcl::PointIndices> clusters;
+  ASSERT_TRUE(seg.extract(clusters));
+  const std::size_t old_triangles = seg.getResult().mesh.triangles.size();
+  const double voxel = seg.getResult().min_voxel_size;
+  ASSERT_TRUE(seg.update(*fine, clusters));
+  const auto& stats = seg.getUpdateStatistics();
+  EXPECT_TRUE(stats.incremental);
+  EXPECT_EQ(stats.new_vertices, fine->size());
+  EXPECT_LT(stats.replaced_triangles, old_triangles / 4);
+  EXPECT_GT(stats.new_triangles, 2 * fine->size());
+  Seg ref;
+  reference(concat(*coarse, *fine), voxel, ref);
+  expectSameResult(seg, ref);
+}
+
+TEST(SelectiveSegmentationUpdate, RepeatedUpdatesAndAnyOrderOfTheNewPoints)
+{
+  auto scan = toXYZ(*selseg_test::cubeScan(8000, 21));
+  const std::size_t n = scan->size();
+  Seg seg;
+  seg.setInputCloud(slice(*scan, 0, n / 2));
+  std::vector<pcl::PointIndices> clusters;
+  ASSERT_TRUE(seg.extract(clusters));
+  const double voxel = seg.getResult().min_voxel_size;
+  auto part = slice(*scan, n / 2, 3 * n / 4);
+  std::mt19937 rng(5);
+  std::shuffle(part->begin(), part->end(), rng);
+  ASSERT_TRUE(seg.update(*part, clusters));
+  ASSERT_TRUE(seg.update(*slice(*scan, 3 * n / 4, n), clusters));
+  EXPECT_TRUE(seg.getUpdateStatistics().incremental);
+  auto all = concat(*slice(*scan, 0, n / 2), *part);
+  *all += *slice(*scan, 3 * n / 4, n);
+  Seg ref;
+  reference(all, voxel, ref);
+  expectSameResult(seg, ref);
+}
+
+TEST(SelectiveSegmentationUpdate, NearerPointOnAnOldRayTakesOverItsVertex)
+{
+  const auto scan = toXYZ(*selseg_test::cubeScan(4000, 3));
+  Seg seg;
+  seg.setInputCloud(scan);
+  std::vector<pcl::PointIndices> clusters;
+  ASSERT_TRUE(seg.extract(clusters));
+  const double voxel = seg.getResult().min_voxel_size;
+  // Same directions, 1% nearer (a re-scan of the same rays), plus bad points.
+  Cloud extra;
+  for (std::size_t i = 0; i < scan->size(); i += 37) {
+    const auto& p = (*scan)[i];
+    extra.push_back(pcl::PointXYZ(0.99f * p.x, 0.99f * p.y, 0.99f * p.z));
+  }
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  extra.push_back(pcl::PointXYZ(nan, 0.0f, 1.0f));
+  extra.push_back(pcl::PointXYZ(0.0f, 0.0f, -1.0f));
+  ASSERT_TRUE(seg.update(extra, clusters));
+  const auto& stats = seg.getUpdateStatistics();
+  EXPECT_TRUE(stats.incremental);
+  // Float rounding moves a few of the scaled points to a neighbouring direction.
+  EXPECT_LT(stats.new_vertices, extra.size() / 4);
+  EXPECT_GT(stats.moved_vertices, 0u);
+  EXPECT_EQ(seg.getResult().counts.non_finite, 1u);
+  EXPECT_EQ(seg.getResult().counts.behind_sensor, 1u);
+  Seg ref;
+  reference(concat(*scan, extra), voxel, ref);
+  expectSameResult(seg, ref);
+}
+
+TEST(SelectiveSegmentationUpdate, IndicesAreExtendedByTheNewPoints)
+{
+  const auto scan = toXYZ(*selseg_test::cubeScan(5000, 4));
+  const std::size_t n = scan->size();
+  auto old_part = slice(*scan, 0, n / 2);
+  auto indices = pcl::make_shared<pcl::Indices>();
+  for (std::size_t i = 0; i < old_part->size(); i += 2)
+    indices->push_back(static_cast<pcl::index_t>(i));
+  Seg seg;
+  seg.setInputCloud(old_part);
+  seg.setIndices(indices);
+  std::vector<pcl::PointIndices> clusters;
+  ASSERT_TRUE(seg.extract(clusters));
+  const double voxel = seg.getResult().min_voxel_size;
+  ASSERT_TRUE(seg.update(*slice(*scan, n / 2, n), clusters));
+  EXPECT_TRUE(seg.getUpdateStatistics().incremental);
+  EXPECT_EQ(seg.getResult().counts.outside_indices, old_part->size() - indices->size());
+
+  Seg ref;
+  auto all_indices = pcl::make_shared<pcl::Indices>(*indices);
+  for (std::size_t i = n / 2; i < n; ++i)
+    all_indices->push_back(static_cast<pcl::index_t>(i));
+  ref.setIndices(all_indices);
+  reference(concat(*old_part, *slice(*scan, n / 2, n)), voxel, ref);
+  expectSameResult(seg, ref);
+}
+
+TEST(SelectiveSegmentationUpdate, ChangedParametersRunFromScratch)
+{
+  const auto scan = toXYZ(*selseg_test::cubeScan(5000, 8));
+  const std::size_t n = scan->size();
+  Seg seg;
+  seg.setInputCloud(slice(*scan, 0, n / 2));
+  std::vector<pcl::PointIndices> clusters;
+  ASSERT_TRUE(seg.extract(clusters));
+  const double voxel = seg.getResult().min_voxel_size;
+  seg.setMaxViewIncidenceAngle(80.0 * M_PI / 180.0);
+  ASSERT_TRUE(seg.update(*slice(*scan, n / 2, n), clusters));
+  EXPECT_FALSE(seg.getUpdateStatistics().incremental);
+  Seg ref;
+  ref.setMaxViewIncidenceAngle(80.0 * M_PI / 180.0);
+  reference(scan, voxel, ref);
+  expectSameResult(seg, ref);
 }
 
 TEST(SelectiveSegmentationUpdate, NeedsAResultToUpdate)
 {
-  SelectiveSegmentation<pcl::PointXYZ> seg;
+  Seg seg;
   std::vector<pcl::PointIndices> clusters;
   EXPECT_FALSE(seg.update(Cloud(), clusters));
   EXPECT_TRUE(clusters.empty());
+}
+
+TEST(SelectiveSegmentationUpdate, NothingNewChangesNothing)
+{
+  const auto scan = toXYZ(*selseg_test::cubeScan(3000, 9));
+  Seg seg;
+  seg.setInputCloud(scan);
+  std::vector<pcl::PointIndices> clusters;
+  ASSERT_TRUE(seg.extract(clusters));
+  const auto labels = seg.getResult().labels;
+  ASSERT_TRUE(seg.update(Cloud(), clusters));
+  EXPECT_TRUE(seg.getUpdateStatistics().incremental);
+  EXPECT_EQ(seg.getUpdateStatistics().new_triangles, 0u);
+  EXPECT_EQ(seg.getResult().labels, labels);
 }

@@ -43,6 +43,75 @@ normalizedOrNaN(const Eigen::Vector3d& sum)
   return Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN());
 }
 
+/** Unit normal toward the eye (NaN when degenerate) and 3-D area of one triangle. */
+void
+triangleNormal(const Vector3fVector& positions,
+               const Triangle& tri,
+               const Eigen::Vector3d& eye,
+               Eigen::Vector3f& normal,
+               double& area)
+{
+  const Eigen::Vector3d a = positions[tri[0]].cast<double>();
+  const Eigen::Vector3d b = positions[tri[1]].cast<double>();
+  const Eigen::Vector3d c = positions[tri[2]].cast<double>();
+  Eigen::Vector3d n = (b - a).cross(c - a);
+  const double twice_area = n.norm();
+  area = 0.5 * twice_area;
+  normal = Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN());
+  if (!(twice_area > 0.0) || !std::isfinite(twice_area))
+    return;
+  n /= twice_area;
+  if (n.dot((a + b + c) / 3.0 - eye) > 0.0)
+    n = -n;
+  normal = n.cast<float>();
+}
+
+/** Whether a triangle is seen more obliquely than acos(min_cos), or degenerate. */
+std::uint8_t
+edgeOn(const Vector3fVector& positions,
+       const Triangle& tri,
+       const Eigen::Vector3f& normal,
+       const Eigen::Vector3d& eye,
+       double min_cos)
+{
+  if (!normal.allFinite())
+    return 1;
+  const Eigen::Vector3d centroid =
+      (positions[tri[0]].cast<double>() + positions[tri[1]].cast<double>() +
+       positions[tri[2]].cast<double>()) /
+      3.0;
+  const Eigen::Vector3d sight = (centroid - eye).normalized();
+  return std::abs(sight.dot(normal.cast<double>())) < min_cos;
+}
+
+/** eq. 2-3 at one vertex over its triangles [begin, end), in that order. */
+void
+vertexNormal(const pcl::index_t* begin,
+             const pcl::index_t* end,
+             const Vector3fVector& normals,
+             const std::vector<double>& areas,
+             Eigen::Vector3f& vertex_normal,
+             double& vertex_area)
+{
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  vertex_area = 0.0;
+  for (const pcl::index_t* it = begin; it != end; ++it) {
+    const auto t = *it;
+    if (std::isfinite(areas[t]))
+      vertex_area += areas[t];                                // eq. 3
+    const double weight = normalWeight(areas[t], normals[t]); // eq. 2
+    if (weight > 0.0) // degenerate triangles are skipped (NaN normals)
+      sum += weight * normals[t].cast<double>();
+  }
+  vertex_normal = normalizedOrNaN(sum);
+}
+
+double
+minViewCosine(double max_incidence)
+{
+  return max_incidence >= M_PI / 2.0 ? 0.0 : std::cos(max_incidence);
+}
+
 } // namespace
 
 void
@@ -59,20 +128,8 @@ computeTriangleNormals(const Vector3fVector& positions,
   const Eigen::Vector3d eye = viewpoint.cast<double>();
   const auto n_tri = static_cast<std::ptrdiff_t>(triangles.size());
 #pragma omp parallel for num_threads(threads(num_threads)) schedule(static)
-  for (std::ptrdiff_t t = 0; t < n_tri; ++t) {
-    const Eigen::Vector3d a = positions[triangles[t][0]].cast<double>();
-    const Eigen::Vector3d b = positions[triangles[t][1]].cast<double>();
-    const Eigen::Vector3d c = positions[triangles[t][2]].cast<double>();
-    Eigen::Vector3d n = (b - a).cross(c - a);
-    const double twice_area = n.norm();
-    areas[t] = 0.5 * twice_area;
-    if (!(twice_area > 0.0) || !std::isfinite(twice_area))
-      continue;
-    n /= twice_area;
-    if (n.dot((a + b + c) / 3.0 - eye) > 0.0)
-      n = -n;
-    normals[t] = n.cast<float>();
-  }
+  for (std::ptrdiff_t t = 0; t < n_tri; ++t)
+    triangleNormal(positions, triangles[t], eye, normals[t], areas[t]);
 }
 
 void
@@ -90,18 +147,13 @@ computeVertexNormals(std::size_t num_vertices,
   vertex_areas.assign(num_vertices, 0.0);
   vertex_normals.resize(num_vertices);
 #pragma omp parallel for num_threads(threads(num_threads)) schedule(static)
-  for (std::ptrdiff_t v = 0; v < static_cast<std::ptrdiff_t>(num_vertices); ++v) {
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    for (auto i = incident.offsets[v]; i < incident.offsets[v + 1]; ++i) {
-      const auto t = incident.items[i];
-      if (std::isfinite(areas[t]))
-        vertex_areas[v] += areas[t];                            // eq. 3
-      const double weight = normalWeight(areas[t], normals[t]); // eq. 2
-      if (weight > 0.0) // degenerate triangles are skipped (NaN normals)
-        sum += weight * normals[t].cast<double>();
-    }
-    vertex_normals[v] = normalizedOrNaN(sum);
-  }
+  for (std::ptrdiff_t v = 0; v < static_cast<std::ptrdiff_t>(num_vertices); ++v)
+    vertexNormal(incident.items.data() + incident.offsets[v],
+                 incident.items.data() + incident.offsets[v + 1],
+                 normals,
+                 areas,
+                 vertex_normals[v],
+                 vertex_areas[v]);
 }
 
 void
@@ -174,21 +226,80 @@ markEdgeOnTriangles(const Vector3fVector& positions,
                     int num_threads)
 {
   edge_on.assign(triangles.size(), 0);
-  const double min_cos = max_incidence >= M_PI / 2.0 ? 0.0 : std::cos(max_incidence);
+  const double min_cos = minViewCosine(max_incidence);
   const Eigen::Vector3d eye = viewpoint.cast<double>();
   const auto n_tri = static_cast<std::ptrdiff_t>(triangles.size());
 #pragma omp parallel for num_threads(threads(num_threads)) schedule(static)
-  for (std::ptrdiff_t t = 0; t < n_tri; ++t) {
-    if (!normals[t].allFinite()) {
-      edge_on[t] = 1;
-      continue;
+  for (std::ptrdiff_t t = 0; t < n_tri; ++t)
+    edge_on[t] = edgeOn(positions, triangles[t], normals[t], eye, min_cos);
+}
+
+void
+updateMeshNormals(const Vector3fVector& positions,
+                  const std::vector<Triangle>& triangles,
+                  const std::vector<Triangle>& neighbours,
+                  const Eigen::Vector3f& viewpoint,
+                  double max_incidence,
+                  const std::vector<pcl::index_t>& changed_triangles,
+                  Vector3fVector& normals,
+                  std::vector<double>& areas,
+                  std::vector<std::uint8_t>& edge_on,
+                  Vector3fVector& vertex_normals,
+                  std::vector<double>& vertex_areas,
+                  int num_threads)
+{
+  const double min_cos = minViewCosine(max_incidence);
+  const Eigen::Vector3d eye = viewpoint.cast<double>();
+  const auto n_changed = static_cast<std::ptrdiff_t>(changed_triangles.size());
+#pragma omp parallel for num_threads(threads(num_threads)) schedule(static)
+  for (std::ptrdiff_t k = 0; k < n_changed; ++k) {
+    const auto t = changed_triangles[k];
+    triangleNormal(positions, triangles[t], eye, normals[t], areas[t]);
+    edge_on[t] = edgeOn(positions, triangles[t], normals[t], eye, min_cos);
+  }
+  // The vertices of the changed triangles, each with one of them.
+  std::vector<std::pair<pcl::index_t, pcl::index_t>> touched; // (vertex, triangle)
+  touched.reserve(3 * changed_triangles.size());
+  for (const auto t : changed_triangles)
+    for (const auto v : triangles[t])
+      touched.emplace_back(v, t);
+  std::sort(touched.begin(), touched.end());
+  touched.erase(std::unique(touched.begin(),
+                            touched.end(),
+                            [](const auto& a, const auto& b) { return a.first == b.first; }),
+                touched.end());
+  const auto n_touched = static_cast<std::ptrdiff_t>(touched.size());
+#pragma omp parallel num_threads(threads(num_threads))
+  {
+    std::vector<pcl::index_t> star;
+#pragma omp for schedule(static)
+    for (std::ptrdiff_t k = 0; k < n_touched; ++k) {
+      // The triangles around the vertex, walked through the adjacency both ways, in
+      // increasing order as computeVertexNormals() sums them.
+      const pcl::index_t v = touched[k].first;
+      const pcl::index_t first = touched[k].second;
+      star.assign(1, first);
+      for (int way = 1; way <= 2; ++way) {
+        pcl::index_t t = first;
+        for (std::size_t guard = 0; guard < triangles.size(); ++guard) {
+          const Triangle& tri = triangles[t];
+          const int j = tri[0] == v ? 0 : (tri[1] == v ? 1 : 2);
+          t = neighbours[t][(j + way) % 3];
+          if (t < 0 || t == first)
+            break;
+          star.push_back(t);
+        }
+        if (t == first)
+          break; // around an interior vertex: one way is enough
+      }
+      std::sort(star.begin(), star.end());
+      vertexNormal(star.data(),
+                   star.data() + star.size(),
+                   normals,
+                   areas,
+                   vertex_normals[v],
+                   vertex_areas[v]);
     }
-    const Eigen::Vector3d centroid = (positions[triangles[t][0]].cast<double>() +
-                                      positions[triangles[t][1]].cast<double>() +
-                                      positions[triangles[t][2]].cast<double>()) /
-                                     3.0;
-    const Eigen::Vector3d sight = (centroid - eye).normalized();
-    edge_on[t] = std::abs(sight.dot(normals[t].cast<double>())) < min_cos;
   }
 }
 

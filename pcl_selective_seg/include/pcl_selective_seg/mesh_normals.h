@@ -111,6 +111,27 @@ PCL_EXPORTS void markEdgeOnTriangles(const Vector3fVector& positions,
                                      std::vector<std::uint8_t>& edge_on,
                                      int num_threads = 0);
 
+/** \brief Recompute, after a local change of the mesh, the triangle normals, areas and
+ * edge-on flags of the changed triangles and the vertex normals and areas (eq. 2-3) of
+ * their vertices; everything else is taken as valid. Gives the values the full
+ * functions above (computeTriangleNormals(), markEdgeOnTriangles(),
+ * computeVertexNormals()) compute on the whole mesh, bit for bit.
+ * \param[in] changed_triangles triangles whose corners or corner positions changed
+ * \param[in,out] normals, areas, edge_on per triangle, sized for the mesh
+ * \param[in,out] vertex_normals, vertex_areas per vertex, sized for the mesh */
+PCL_EXPORTS void updateMeshNormals(const Vector3fVector& positions,
+                                   const std::vector<Triangle>& triangles,
+                                   const std::vector<Triangle>& neighbours,
+                                   const Eigen::Vector3f& viewpoint,
+                                   double max_incidence,
+                                   const std::vector<pcl::index_t>& changed_triangles,
+                                   Vector3fVector& normals,
+                                   std::vector<double>& areas,
+                                   std::vector<std::uint8_t>& edge_on,
+                                   Vector3fVector& vertex_normals,
+                                   std::vector<double>& vertex_areas,
+                                   int num_threads = 0);
+
 /** \brief Median 3-D length of the triangles' edges [m] (each interior edge counted
  * twice); 0 for an empty mesh. The octree's automatic minimum voxel size scales it. */
 PCL_EXPORTS double medianEdgeLength(const Vector3fVector& positions,

@@ -50,6 +50,19 @@ namespace selective_seg {
  * are reported in the cloud frame. The octree's voxels are aligned with the sensor
  * axes.
  */
+/** \brief What the last SelectiveSegmentation::update() changed. */
+struct UpdateStatistics {
+  /** The mesh and normals were updated in place; false: the pipeline ran from scratch
+   * on the union (no mesh to update, or parameters or sensor pose changed since). */
+  bool incremental = false;
+  std::size_t new_points = 0;         ///< points given to update()
+  std::size_t new_vertices = 0;       ///< mesh vertices they added
+  std::size_t moved_vertices = 0;     ///< vertices now represented by a nearer new point
+  std::size_t replaced_triangles = 0; ///< old triangles the insertion replaced
+  std::size_t new_triangles = 0;      ///< triangles not in the old mesh
+  std::size_t changed_vertices = 0;   ///< vertices whose normal was recomputed
+};
+
 template <typename PointT> class SelectiveSegmentation : public pcl::PCLBase<PointT> {
 public:
   using Ptr = pcl::shared_ptr<SelectiveSegmentation<PointT>>;
@@ -139,6 +152,9 @@ public:
    * \return as extract(); false also when there is no result to update. */
   bool update(const PointCloud& new_points, std::vector<pcl::PointIndices>& clusters);
 
+  /** \brief What the last update() changed. */
+  const UpdateStatistics& getUpdateStatistics() const { return update_stats_; }
+
   /** \brief Labels, segments, leaves, mesh, counts and timings of the last extract().
    */
   const SegmentationResult& getResult() const { return result_; }
@@ -181,6 +197,21 @@ protected:
   /** \brief Stage 3: triangle and point normals and areas (eq. 2-3). */
   bool computeNormals();
 
+  /** \brief The point normals cloud and the median spacing from the vertex normals;
+   * false when no point has a normal. */
+  bool publishNormals();
+
+  /** \brief Stages 4-5 and the clusters, after the mesh and its normals. */
+  bool segmentMesh(std::vector<pcl::PointIndices>& clusters);
+
+  /** \brief update(): stages 1-3 for the new points only; false when they must run
+   * from scratch (the state is then unchanged), or set \a failed (reported). */
+  bool updateMesh(std::size_t first_new_point, bool& failed);
+
+  /** \brief update(): triangle and vertex normals where the mesh changed. */
+  void updateNormals(const DelaunayInsertion& info,
+                     const std::vector<pcl::index_t>& moved_vertices);
+
   /** \brief Stage 4: the multi-resolution octree (eq. 4-5). */
   bool buildOctree();
 
@@ -220,6 +251,10 @@ private:
       vertex_mean_normals_; ///< per triangle, for EdgeTriangleNormal::VertexMean
   std::vector<pcl::index_t> vertex_leaf_;
   SegmentationResult result_;
+  /** Parameters and sensor pose the current mesh and normals were computed with. */
+  SelectiveSegmentationParameters mesh_params_;
+  Eigen::Matrix4f mesh_pose_ = Eigen::Matrix4f::Zero();
+  UpdateStatistics update_stats_;
 };
 
 } // namespace selective_seg

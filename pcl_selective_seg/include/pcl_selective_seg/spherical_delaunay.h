@@ -7,6 +7,7 @@
 #pragma once
 
 #include <pcl_selective_seg/delaunay_2d.h>
+#include <pcl_selective_seg/delaunay_2d_update.h>
 
 #include <Eigen/Geometry>
 #include <pcl/surface/reconstruction.h>
@@ -118,6 +119,23 @@ public:
    *         a backend failure. Fewer than three distinct non-collinear positions is not
    *         a failure: the result then has no triangle. */
   bool triangulate();
+
+  /** \brief Fold the input points from \a first_new_point on into the triangulation of
+   * the last triangulate() call, whose input was the points before them (same sensor
+   * pose and quantization). The result equals triangulate() on the whole input; only
+   * the new points are projected, and the triangulation changes only where they fall
+   * (insertDelaunayPoints()).
+   * \param[in] first_new_point the old input's size; the indices must be the old ones
+   *            followed by indices of new points
+   * \param[out] info the renumbering of the vertices and triangles
+   * \param[out] moved_vertices vertices (new ids) whose representative point changed to
+   *             a new point nearer to the sensor
+   * \return false when the update is impossible (no previous triangulation with
+   *         triangles, inconsistent input); the triangulation is then unchanged and
+   *         triangulate() should run instead. */
+  bool insertPoints(std::size_t first_new_point,
+                    DelaunayInsertion& info,
+                    std::vector<pcl::index_t>& moved_vertices);
 
   /** \brief The triangulation of the last reconstruct() or triangulate() call. */
   const SphericalTriangulation& getTriangulation() const { return triangulation_; }

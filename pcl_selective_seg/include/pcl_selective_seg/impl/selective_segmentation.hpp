@@ -125,6 +125,15 @@ SelectiveSegmentation<PointT>::computeNormals()
                                   triangle_areas_,
                                   params_.normal_rings,
                                   vertex_normals_);
+  return publishNormals();
+}
+
+template <typename PointT>
+bool
+SelectiveSegmentation<PointT>::publishNormals()
+{
+  const SphericalTriangulation& tri = delaunay_.getTriangulation();
+  const auto& positions = tri.vertex_positions;
   const float nan = std::numeric_limits<float>::quiet_NaN();
   normals_.reset(
       new NormalCloud(input_->width, input_->height, pcl::Normal(nan, nan, nan, nan)));
@@ -366,7 +375,19 @@ SelectiveSegmentation<PointT>::extract(std::vector<pcl::PointIndices>& clusters)
   if (!computeNormals())
     return false;
   result_.timings.normals = watch.getTimeSeconds();
-  watch.reset();
+  mesh_params_ = params_;
+  mesh_pose_ = delaunay_.getSensorPose().matrix();
+  if (!segmentMesh(clusters))
+    return false;
+  result_.timings.total = total.getTimeSeconds();
+  return true;
+}
+
+template <typename PointT>
+bool
+SelectiveSegmentation<PointT>::segmentMesh(std::vector<pcl::PointIndices>& clusters)
+{
+  pcl::StopWatch watch;
   if (!buildOctree())
     return false;
   result_.timings.octree = watch.getTimeSeconds();
@@ -383,47 +404,7 @@ SelectiveSegmentation<PointT>::extract(std::vector<pcl::PointIndices>& clusters)
     PCL_WARN("[pcl::selective_seg::%s::extract] no segment found\n",
              getClassName().c_str());
   this->deinitCompute();
-  result_.timings.total = total.getTimeSeconds();
   return true;
-}
-
-template <typename PointT>
-bool
-SelectiveSegmentation<PointT>::update(const PointCloud& new_points,
-                                      std::vector<pcl::PointIndices>& clusters)
-{
-  clusters.clear();
-  if (!input_ || result_.segments.empty() || result_.labels.size() != input_->size()) {
-    PCL_ERROR("[pcl::selective_seg::%s::update] no result to update: call extract() "
-              "first\n",
-              getClassName().c_str());
-    return false;
-  }
-  auto merged = pcl::make_shared<PointCloud>();
-  merged->reserve(input_->size() + new_points.size());
-  merged->points.insert(merged->end(), input_->begin(), input_->end());
-  merged->points.insert(merged->end(), new_points.begin(), new_points.end());
-  merged->width = static_cast<std::uint32_t>(merged->points.size());
-  merged->height = 1;
-  merged->is_dense = input_->is_dense && new_points.is_dense;
-  merged->header = input_->header;
-  merged->sensor_origin_ = input_->sensor_origin_;
-  merged->sensor_orientation_ = input_->sensor_orientation_;
-  if (!this->fake_indices_ && indices_) {
-    auto indices = pcl::make_shared<pcl::Indices>(*indices_);
-    for (std::size_t i = 0; i < new_points.size(); ++i)
-      indices->push_back(static_cast<pcl::index_t>(input_->size() + i));
-    this->setInputCloud(merged);
-    this->setIndices(indices);
-  }
-  else
-    this->setInputCloud(merged);
-  const SelectiveSegmentationParameters saved = params_;
-  if (!(params_.min_voxel_size > 0.0))
-    params_.min_voxel_size = result_.min_voxel_size;
-  const bool ok = extract(clusters);
-  params_ = saved;
-  return ok;
 }
 
 template <typename PointT>
@@ -463,6 +444,8 @@ SelectiveSegmentation<PointT>::getPolygonMesh(pcl::PolygonMesh& mesh) const
 
 } // namespace selective_seg
 } // namespace pcl
+
+#include <pcl_selective_seg/impl/selective_segmentation_update.hpp>
 
 #define PCL_INSTANTIATE_SelectiveSegmentation(T)                                       \
   template class PCL_EXPORTS pcl::selective_seg::SelectiveSegmentation<T>;

@@ -262,5 +262,7 @@ SphericalDelaunay<PointT>::performReconstruction(std::vector<pcl::Vertices>& pol
 } // namespace selective_seg
 } // namespace pcl
 
+#include <pcl_selective_seg/impl/spherical_delaunay_update.hpp>
+
 #define PCL_INSTANTIATE_SphericalDelaunay(T)                                           \
   template class PCL_EXPORTS pcl::selective_seg::SphericalDelaunay<T>;

@@ -1,0 +1,195 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
+ */
+
+#pragma once
+
+#include <pcl_selective_seg/selective_segmentation.h>
+
+#include <pcl/common/time.h>
+#include <pcl/console/print.h>
+
+namespace pcl {
+namespace selective_seg {
+
+template <typename PointT>
+bool
+SelectiveSegmentation<PointT>::update(const PointCloud& new_points,
+                                      std::vector<pcl::PointIndices>& clusters)
+{
+  clusters.clear();
+  if (!input_ || result_.segments.empty() || result_.labels.size() != input_->size()) {
+    PCL_ERROR("[pcl::selective_seg::%s::update] no result to update: call extract() "
+              "first\n",
+              getClassName().c_str());
+    return false;
+  }
+  pcl::StopWatch total;
+  update_stats_ = UpdateStatistics();
+  update_stats_.new_points = new_points.size();
+  const std::size_t first_new = input_->size();
+  auto merged = pcl::make_shared<PointCloud>();
+  merged->reserve(first_new + new_points.size());
+  merged->points.insert(merged->end(), input_->begin(), input_->end());
+  merged->points.insert(merged->end(), new_points.begin(), new_points.end());
+  merged->width = static_cast<std::uint32_t>(merged->points.size());
+  merged->height = 1;
+  merged->is_dense = input_->is_dense && new_points.is_dense;
+  merged->header = input_->header;
+  merged->sensor_origin_ = input_->sensor_origin_;
+  merged->sensor_orientation_ = input_->sensor_orientation_;
+  if (!this->fake_indices_ && indices_) {
+    auto indices = pcl::make_shared<pcl::Indices>(*indices_);
+    for (std::size_t i = 0; i < new_points.size(); ++i)
+      indices->push_back(static_cast<pcl::index_t>(first_new + i));
+    this->setInputCloud(merged);
+    this->setIndices(indices);
+  }
+  else
+    this->setInputCloud(merged);
+
+  // The finest voxel of the result being updated is kept (see the header).
+  const SelectiveSegmentationParameters saved = params_;
+  if (!(params_.min_voxel_size > 0.0))
+    params_.min_voxel_size = result_.min_voxel_size;
+  bool ok = false;
+  bool failed = false;
+  if (updateMesh(first_new, failed)) {
+    ok = segmentMesh(clusters);
+    result_.timings.total = total.getTimeSeconds();
+  }
+  else if (!failed) {
+    ok = extract(clusters); // no triangulation to update: from scratch on the union
+  }
+  params_ = saved;
+  return ok;
+}
+
+template <typename PointT>
+bool
+SelectiveSegmentation<PointT>::updateMesh(std::size_t first_new_point, bool& failed)
+{
+  failed = false;
+  if (!initCompute()) {
+    this->deinitCompute();
+    failed = true;
+    return false;
+  }
+  pcl::StopWatch watch;
+  delaunay_.setInputCloud(input_);
+  delaunay_.setIndices(indices_);
+  // In place only with the parameters and pose the mesh was made with, for the exact
+  // backends (VTK's output is not the canonical triangulation) and the paper's one-
+  // ring normals.
+  const bool same_mesh_parameters =
+      params_.angle_quantization == mesh_params_.angle_quantization &&
+      params_.max_view_incidence_angle == mesh_params_.max_view_incidence_angle &&
+      params_.normal_rings == 1 && mesh_params_.normal_rings == 1 &&
+      params_.delaunay_backend != DelaunayBackend::Vtk &&
+      mesh_params_.delaunay_backend != DelaunayBackend::Vtk &&
+      delaunay_.getSensorPose().matrix() == mesh_pose_ &&
+      triangle_normals_.size() == delaunay_.getTriangulation().triangles.size();
+  DelaunayInsertion info;
+  std::vector<pcl::index_t> moved;
+  if (!same_mesh_parameters || !delaunay_.insertPoints(first_new_point, info, moved)) {
+    this->deinitCompute();
+    return false;
+  }
+  const SphericalTriangulation& tri = delaunay_.getTriangulation();
+  update_stats_.incremental = true;
+  update_stats_.new_vertices = info.inserted_points.size();
+  update_stats_.moved_vertices = moved.size();
+  update_stats_.replaced_triangles = info.replaced_triangles;
+  update_stats_.new_triangles = info.new_triangles.size();
+  result_.clear();
+  octree_.reset();
+  normals_.reset();
+  vertex_mean_normals_.clear();
+  result_.counts.outside_indices = tri.num_outside_indices;
+  result_.counts.non_finite = tri.num_non_finite;
+  result_.counts.behind_sensor = tri.num_behind_sensor;
+  result_.num_vertices = tri.vertex_point.size();
+  result_.timings.delaunay = watch.getTimeSeconds();
+  watch.reset();
+  updateNormals(info, moved);
+  if (!publishNormals()) {
+    failed = true;
+    return false;
+  }
+  result_.timings.normals = watch.getTimeSeconds();
+  mesh_params_ = params_;
+  return true;
+}
+
+template <typename PointT>
+void
+SelectiveSegmentation<PointT>::updateNormals(const DelaunayInsertion& info,
+                                             const std::vector<pcl::index_t>& moved)
+{
+  const SphericalTriangulation& tri = delaunay_.getTriangulation();
+  const std::size_t num_triangles = tri.triangles.size();
+  const std::size_t num_vertices = tri.vertex_positions.size();
+  // Kept triangles keep their normals, unless a corner moved.
+  std::vector<pcl::index_t> source(num_triangles, -1);
+  for (std::size_t t = 0; t < info.old_to_new_triangle.size(); ++t)
+    if (info.old_to_new_triangle[t] >= 0)
+      source[info.old_to_new_triangle[t]] = static_cast<pcl::index_t>(t);
+  if (!moved.empty()) {
+    std::vector<std::uint8_t> is_moved(num_vertices, 0);
+    for (const auto v : moved)
+      is_moved[v] = 1;
+    for (std::size_t t = 0; t < num_triangles; ++t) {
+      const Triangle& c = tri.triangles[t];
+      if (is_moved[c[0]] || is_moved[c[1]] || is_moved[c[2]])
+        source[t] = -1;
+    }
+  }
+  Vector3fVector normals(num_triangles);
+  std::vector<double> areas(num_triangles, 0.0);
+  std::vector<std::uint8_t> edge_on(num_triangles, 0);
+  std::vector<pcl::index_t> changed;
+  for (std::size_t t = 0; t < num_triangles; ++t) {
+    const pcl::index_t s = source[t];
+    if (s < 0) {
+      changed.push_back(static_cast<pcl::index_t>(t));
+      continue;
+    }
+    normals[t] = triangle_normals_[s];
+    areas[t] = triangle_areas_[s];
+    edge_on[t] = triangle_edge_on_[s];
+  }
+  Vector3fVector vertex_normals(num_vertices);
+  auto vertex_areas = std::make_shared<std::vector<double>>(num_vertices, 0.0);
+  for (std::size_t v = 0; v < info.old_to_new_point.size(); ++v) {
+    vertex_normals[info.old_to_new_point[v]] = vertex_normals_[v];
+    (*vertex_areas)[info.old_to_new_point[v]] = (*vertex_areas_)[v];
+  }
+  updateMeshNormals(tri.vertex_positions,
+                    tri.triangles,
+                    tri.neighbours,
+                    Eigen::Vector3f::Zero(),
+                    params_.max_view_incidence_angle,
+                    changed,
+                    normals,
+                    areas,
+                    edge_on,
+                    vertex_normals,
+                    *vertex_areas,
+                    params_.num_threads);
+  std::vector<std::uint8_t> touched(num_vertices, 0);
+  for (const auto t : changed)
+    for (const auto v : tri.triangles[t])
+      touched[v] = 1;
+  update_stats_.changed_vertices =
+      static_cast<std::size_t>(std::count(touched.begin(), touched.end(), 1));
+  triangle_normals_.swap(normals);
+  triangle_areas_.swap(areas);
+  triangle_edge_on_.swap(edge_on);
+  vertex_normals_.swap(vertex_normals);
+  vertex_areas_ = vertex_areas;
+}
+
+} // namespace selective_seg
+} // namespace pcl

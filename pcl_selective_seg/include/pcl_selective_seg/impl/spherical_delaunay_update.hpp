@@ -1,0 +1,163 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
+ */
+
+#pragma once
+
+#include <pcl_selective_seg/spherical_delaunay.h>
+
+#include <pcl/common/point_tests.h>
+#include <pcl/console/print.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace pcl {
+namespace selective_seg {
+
+template <typename PointT>
+bool
+SphericalDelaunay<PointT>::insertPoints(std::size_t first_new_point,
+                                        DelaunayInsertion& info,
+                                        std::vector<pcl::index_t>& moved_vertices)
+{
+  moved_vertices.clear();
+  SphericalTriangulation& tri = triangulation_;
+  if (!this->input_ || tri.triangles.empty() ||
+      tri.point_vertex.size() != first_new_point ||
+      first_new_point > this->input_->size() ||
+      tri.angle_quantization != angle_quantization_)
+    return false;
+  if (!this->initCompute())
+    return false;
+  const auto& cloud = *this->input_;
+  const auto& indices = *this->indices_;
+  const auto n = static_cast<pcl::index_t>(cloud.size());
+  const Eigen::Affine3d pose = getSensorPose().template cast<double>();
+
+  // The new points' angles, as projectAndMergeVertices() computes them.
+  std::vector<std::pair<std::uint64_t, pcl::index_t>> keyed;
+  std::vector<std::pair<pcl::index_t, pcl::index_t>> excluded; // (point, status)
+  for (const pcl::index_t i : indices) {
+    if (i < 0 || i >= n) {
+      this->deinitCompute();
+      return false;
+    }
+    if (static_cast<std::size_t>(i) < first_new_point)
+      continue;
+    if (!pcl::isXYZFinite(cloud[i])) {
+      excluded.emplace_back(i, kNonFinite);
+      continue;
+    }
+    const Eigen::Vector3d s = toSensorFrame(pose, i);
+    if (!(s.z() > 0.0)) {
+      excluded.emplace_back(i, kBehindSensor);
+      continue;
+    }
+    const QuantizedPoint q{static_cast<std::int32_t>(std::lround(
+                               std::atan2(s.x(), s.z()) / angle_quantization_)),
+                           static_cast<std::int32_t>(std::lround(
+                               std::atan2(s.y(), s.z()) / angle_quantization_))};
+    keyed.emplace_back(detail::angleKey(q), i);
+  }
+  std::sort(keyed.begin(), keyed.end());
+
+  // Runs of equal angles: an existing vertex (its representative may change) or a new
+  // vertex.
+  std::vector<QuantizedPoint> new_angles;
+  std::vector<pcl::index_t> new_representative;
+  std::vector<std::pair<pcl::index_t, pcl::index_t>> point_to_old; // (point, old v)
+  std::vector<std::pair<pcl::index_t, pcl::index_t>> point_to_new; // (point, new k)
+  for (std::size_t begin = 0; begin < keyed.size();) {
+    std::size_t end = begin + 1;
+    while (end < keyed.size() && keyed[end].first == keyed[begin].first)
+      ++end;
+    const QuantizedPoint q = detail::keyAngles(keyed[begin].first);
+    const auto it = std::lower_bound(tri.vertex_angles.begin(), tri.vertex_angles.end(), q);
+    pcl::index_t best = keyed[begin].second;
+    for (std::size_t k = begin + 1; k < end; ++k)
+      if (isCloserRepresentative(pose, keyed[k].second, best))
+        best = keyed[k].second;
+    if (it != tri.vertex_angles.end() && *it == q) {
+      const auto v = static_cast<pcl::index_t>(it - tri.vertex_angles.begin());
+      for (std::size_t k = begin; k < end; ++k)
+        point_to_old.emplace_back(keyed[k].second, v);
+      if (isCloserRepresentative(pose, best, tri.vertex_point[v]))
+        point_to_old.emplace_back(-1 - best, v); // marks the new representative
+    }
+    else {
+      const auto k_new = static_cast<pcl::index_t>(new_angles.size());
+      new_angles.push_back(q);
+      new_representative.push_back(best);
+      for (std::size_t k = begin; k < end; ++k)
+        point_to_new.emplace_back(keyed[k].second, k_new);
+    }
+    begin = end;
+  }
+
+  std::vector<QuantizedPoint> angles = tri.vertex_angles;
+  std::vector<Triangle> triangles = tri.triangles;
+  std::vector<Triangle> neighbours = tri.neighbours;
+  std::string why;
+  if (!insertDelaunayPoints(angles, triangles, neighbours, new_angles, info, &why)) {
+    PCL_DEBUG("[pcl::selective_seg::%s::insertPoints] %s: triangulating again\n",
+              getClassName().c_str(),
+              why.c_str());
+    this->deinitCompute();
+    return false;
+  }
+
+  // Renumber the vertex arrays and the point map.
+  const std::size_t num_vertices = angles.size();
+  pcl::Indices vertex_point(num_vertices);
+  std::vector<Eigen::Vector3f> positions(num_vertices);
+  for (std::size_t v = 0; v < tri.vertex_point.size(); ++v) {
+    vertex_point[info.old_to_new_point[v]] = tri.vertex_point[v];
+    positions[info.old_to_new_point[v]] = tri.vertex_positions[v];
+  }
+  for (std::size_t k = 0; k < new_angles.size(); ++k) {
+    const pcl::index_t v = info.inserted_points[k];
+    vertex_point[v] = new_representative[k];
+    positions[v] = toSensorFrame(pose, new_representative[k]).template cast<float>();
+  }
+  for (const auto& entry : point_to_old)
+    if (entry.first < 0) { // a new representative
+      const pcl::index_t v = info.old_to_new_point[entry.second];
+      const pcl::index_t best = -1 - entry.first;
+      vertex_point[v] = best;
+      positions[v] = toSensorFrame(pose, best).template cast<float>();
+      moved_vertices.push_back(v);
+    }
+  std::vector<pcl::index_t> point_vertex(cloud.size(), kOutsideIndices);
+  for (std::size_t i = 0; i < first_new_point; ++i) {
+    const pcl::index_t v = tri.point_vertex[i];
+    point_vertex[i] = v >= 0 ? info.old_to_new_point[v] : v;
+  }
+  for (const auto& entry : excluded)
+    point_vertex[entry.first] = entry.second;
+  for (const auto& entry : point_to_old)
+    if (entry.first >= 0)
+      point_vertex[entry.first] = info.old_to_new_point[entry.second];
+  for (const auto& entry : point_to_new)
+    point_vertex[entry.first] = info.inserted_points[entry.second];
+
+  tri.point_vertex.swap(point_vertex);
+  tri.vertex_point.swap(vertex_point);
+  tri.vertex_angles.swap(angles);
+  tri.vertex_positions.swap(positions);
+  tri.triangles.swap(triangles);
+  tri.neighbours.swap(neighbours);
+  tri.num_outside_indices = tri.num_non_finite = tri.num_behind_sensor = 0;
+  for (const auto v : tri.point_vertex) {
+    tri.num_outside_indices += (v == kOutsideIndices);
+    tri.num_non_finite += (v == kNonFinite);
+    tri.num_behind_sensor += (v == kBehindSensor);
+  }
+  this->deinitCompute();
+  return true;
+}
+
+} // namespace selective_seg
+} // namespace pcl
