@@ -1,0 +1,138 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
+ */
+
+// SelectiveSegmentation::update() against extract() on the same union of points: a
+// simulated door scan (the paper's Fig. 6 scene, irregular density) plus a finer scan
+// (4x the density) of one angular window holding 5% of the union's points. The ratio
+// of the two medians is the speed-up of the incremental update
+// (docs/selective_sensing.md). Run: build/test/selseg_benchmark_update
+
+#include <pcl_selective_seg/selective_segmentation.h>
+#include <pcl_selective_seg/sensor_simulator.h>
+
+#include <benchmark/benchmark.h>
+#include <pcl/common/io.h>
+
+#include <cmath>
+#include <map>
+
+namespace {
+
+using Cloud = pcl::PointCloud<pcl::PointXYZ>;
+namespace sim = pcl::selective_seg::simulation;
+
+Cloud::Ptr
+doorScan(std::size_t n, unsigned seed)
+{
+  auto setup = sim::makeDoorScene(static_cast<double>(n) /
+                                  sim::getPaperPointCount(sim::PaperScene::Door));
+  setup.sensor.density_ratio = 10.0;
+  setup.sensor.seed = seed;
+  sim::SensorSimulator simulator;
+  simulator.setParameters(setup.sensor);
+  pcl::PointCloud<pcl::PointXYZL> labeled;
+  simulator.simulate(setup.scene, labeled);
+  auto xyz = pcl::make_shared<Cloud>();
+  pcl::copyPointCloud(labeled, *xyz);
+  return xyz;
+}
+
+struct Scenario {
+  Cloud::Ptr coarse, fine, all;
+};
+
+/** The coarse scan of about n points and a 4x finer scan of a centred window, grown
+ * until it holds 5% of the union's points. */
+const Scenario&
+scenario(std::size_t n)
+{
+  static std::map<std::size_t, Scenario> cache;
+  Scenario& s = cache[n];
+  if (s.coarse)
+    return s;
+  s.coarse = doorScan(n, 1);
+  const auto dense = doorScan(4 * n, 2);
+  const std::size_t wanted = n * 5 / 95;
+  s.fine = pcl::make_shared<Cloud>();
+  for (double half = 0.01; half < 1.0 && s.fine->size() < wanted; half *= 1.05) {
+    s.fine->clear();
+    for (const auto& p : *dense)
+      if (std::abs(std::atan2(p.x, p.z)) <= half &&
+          std::abs(std::atan2(p.y, p.z)) <= half)
+        s.fine->push_back(p);
+  }
+  s.all = pcl::make_shared<Cloud>(*s.coarse);
+  *s.all += *s.fine;
+  return s;
+}
+
+void
+setTimings(benchmark::State& state, const pcl::selective_seg::SegmentationResult& r)
+{
+  state.counters["delaunay_s"] = r.timings.delaunay;
+  state.counters["normals_s"] = r.timings.normals;
+  state.counters["octree_s"] = r.timings.octree;
+  state.counters["merge_s"] = r.timings.merge;
+}
+
+void
+BM_ExtractUnion(benchmark::State& state)
+{
+  const Scenario& s = scenario(static_cast<std::size_t>(state.range(0)));
+  pcl::selective_seg::SelectiveSegmentation<pcl::PointXYZ> first;
+  first.setInputCloud(s.coarse);
+  std::vector<pcl::PointIndices> clusters;
+  first.extract(clusters);
+  pcl::selective_seg::SelectiveSegmentation<pcl::PointXYZ> seg;
+  seg.setMinVoxelSize(first.getResult().min_voxel_size); // as update() keeps it
+  seg.setInputCloud(s.all);
+  for (auto _ : state)
+    benchmark::DoNotOptimize(seg.extract(clusters));
+  setTimings(state, seg.getResult());
+  state.counters["points"] = static_cast<double>(s.all->size());
+  state.counters["window_points"] = static_cast<double>(s.fine->size());
+}
+
+void
+BM_Update(benchmark::State& state)
+{
+  const Scenario& s = scenario(static_cast<std::size_t>(state.range(0)));
+  pcl::selective_seg::SelectiveSegmentation<pcl::PointXYZ> seg;
+  std::vector<pcl::PointIndices> clusters;
+  for (auto _ : state) {
+    state.PauseTiming();
+    seg.setInputCloud(s.coarse);
+    seg.extract(clusters);
+    state.ResumeTiming();
+    benchmark::DoNotOptimize(seg.update(*s.fine, clusters));
+  }
+  setTimings(state, seg.getResult());
+  const auto& u = seg.getUpdateStatistics();
+  state.counters["incremental"] = u.incremental;
+  state.counters["replaced_triangles"] = static_cast<double>(u.replaced_triangles);
+  state.counters["points"] = static_cast<double>(s.all->size());
+}
+
+} // namespace
+
+BENCHMARK(BM_ExtractUnion)
+    ->Arg(46000)
+    ->Arg(300000)
+    ->Arg(1000000)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Repetitions(3)
+    ->ReportAggregatesOnly(true);
+BENCHMARK(BM_Update)
+    ->Arg(46000)
+    ->Arg(300000)
+    ->Arg(1000000)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Repetitions(3)
+    ->ReportAggregatesOnly(true);
+
+BENCHMARK_MAIN();
