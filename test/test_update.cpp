@@ -121,6 +121,16 @@ reference(const Cloud::Ptr& all, double voxel, Seg& ref)
   ASSERT_TRUE(ref.extract(clusters));
 }
 
+/** The first run; returns its finest voxel (the one update() keeps). */
+double
+extractFirst(Seg& seg, const Cloud::Ptr& cloud)
+{
+  seg.setInputCloud(cloud);
+  std::vector<pcl::PointIndices> clusters;
+  EXPECT_TRUE(seg.extract(clusters));
+  return seg.getResult().min_voxel_size;
+}
+
 Cloud::Ptr
 concat(const Cloud& a, const Cloud& b)
 {
@@ -138,10 +148,8 @@ TEST(SelectiveSegmentationUpdate, RandomFifthOfTheScanEqualsExtractOnTheUnion)
   std::shuffle(scan->begin(), scan->end(), rng);
   const std::size_t split = scan->size() * 4 / 5;
   Seg seg;
-  seg.setInputCloud(slice(*scan, 0, split));
+  const double voxel = extractFirst(seg, slice(*scan, 0, split));
   std::vector<pcl::PointIndices> clusters;
-  ASSERT_TRUE(seg.extract(clusters));
-  const double voxel = seg.getResult().min_voxel_size;
   ASSERT_TRUE(seg.update(*slice(*scan, split, scan->size()), clusters));
   EXPECT_TRUE(seg.getUpdateStatistics().incremental);
   EXPECT_EQ(seg.getUpdateStatistics().new_points, scan->size() - split);
@@ -196,10 +204,8 @@ TEST(SelectiveSegmentationUpdate, RepeatedUpdatesAndAnyOrderOfTheNewPoints)
   auto scan = toXYZ(*selseg_test::cubeScan(8000, 21));
   const std::size_t n = scan->size();
   Seg seg;
-  seg.setInputCloud(slice(*scan, 0, n / 2));
+  const double voxel = extractFirst(seg, slice(*scan, 0, n / 2));
   std::vector<pcl::PointIndices> clusters;
-  ASSERT_TRUE(seg.extract(clusters));
-  const double voxel = seg.getResult().min_voxel_size;
   auto part = slice(*scan, n / 2, 3 * n / 4);
   std::mt19937 rng(5);
   std::shuffle(part->begin(), part->end(), rng);
@@ -217,10 +223,8 @@ TEST(SelectiveSegmentationUpdate, NearerPointOnAnOldRayTakesOverItsVertex)
 {
   const auto scan = toXYZ(*selseg_test::cubeScan(4000, 3));
   Seg seg;
-  seg.setInputCloud(scan);
+  const double voxel = extractFirst(seg, scan);
   std::vector<pcl::PointIndices> clusters;
-  ASSERT_TRUE(seg.extract(clusters));
-  const double voxel = seg.getResult().min_voxel_size;
   // Same directions, 1% nearer (a re-scan of the same rays), plus bad points.
   Cloud extra;
   for (std::size_t i = 0; i < scan->size(); i += 37) {
@@ -275,10 +279,8 @@ TEST(SelectiveSegmentationUpdate, ChangedParametersRunFromScratch)
   const auto scan = toXYZ(*selseg_test::cubeScan(5000, 8));
   const std::size_t n = scan->size();
   Seg seg;
-  seg.setInputCloud(slice(*scan, 0, n / 2));
+  const double voxel = extractFirst(seg, slice(*scan, 0, n / 2));
   std::vector<pcl::PointIndices> clusters;
-  ASSERT_TRUE(seg.extract(clusters));
-  const double voxel = seg.getResult().min_voxel_size;
   seg.setMaxViewIncidenceAngle(80.0 * M_PI / 180.0);
   ASSERT_TRUE(seg.update(*slice(*scan, n / 2, n), clusters));
   EXPECT_FALSE(seg.getUpdateStatistics().incremental);

@@ -78,8 +78,8 @@ private:
    * and \a exit is the hull edge the walk left through. */
   bool locate(const QuantizedPoint& q, pcl::index_t& start, HullEdge& exit) const;
 
-  HullEdge nextHullEdge(HullEdge h) const;
-  HullEdge previousHullEdge(HullEdge h) const;
+  /** The next hull edge counter-clockwise (forward) or clockwise. */
+  HullEdge nextHullEdge(HullEdge h, bool forward) const;
 
   bool visible(const HullEdge& h, const QuantizedPoint& q) const
   {
@@ -136,36 +136,22 @@ Inserter::locate(const QuantizedPoint& q, pcl::index_t& start, HullEdge& exit) c
 }
 
 HullEdge
-Inserter::nextHullEdge(HullEdge h) const
+Inserter::nextHullEdge(HullEdge h, bool forward) const
 {
-  // Rotate around the edge's end vertex, through the interior, to the next hull edge.
-  const pcl::index_t end = t_[h.triangle][(h.opposite + 2) % 3];
+  // Rotate through the interior around the edge's end vertex (forward) or start vertex
+  // (backward) to the hull edge that leaves it (arrives at it).
+  const int corner = (h.opposite + (forward ? 2 : 1)) % 3;
+  const int step = forward ? 2 : 1; // from the pivot to the vertex opposite the edge
+  const pcl::index_t pivot = t_[h.triangle][corner];
   pcl::index_t cur = h.triangle;
-  int j = (h.opposite + 2) % 3;
+  int j = corner;
   for (std::size_t guard = 0; guard <= t_.size(); ++guard) {
-    const int opp = (j + 2) % 3; // the edge leaving `end` in cur
+    const int opp = (j + step) % 3; // the other edge at the pivot in cur
     const pcl::index_t next = n_[cur][opp];
     if (next < 0)
       return {cur, opp};
     cur = next;
-    j = localIndex(t_[cur], end);
-  }
-  return {-1, 0};
-}
-
-HullEdge
-Inserter::previousHullEdge(HullEdge h) const
-{
-  const pcl::index_t begin = t_[h.triangle][(h.opposite + 1) % 3];
-  pcl::index_t cur = h.triangle;
-  int j = (h.opposite + 1) % 3;
-  for (std::size_t guard = 0; guard <= t_.size(); ++guard) {
-    const int opp = (j + 1) % 3; // the edge arriving at `begin` in cur
-    const pcl::index_t next = n_[cur][opp];
-    if (next < 0)
-      return {cur, opp};
-    cur = next;
-    j = localIndex(t_[cur], begin);
+    j = localIndex(t_[cur], pivot);
   }
   return {-1, 0};
 }
@@ -231,14 +217,11 @@ Inserter::run(const std::vector<QuantizedPoint>& q,
     };
     visit(exit);
     std::size_t guard = 0;
-    for (HullEdge h = nextHullEdge(exit);
-         h.triangle >= 0 && visible(h, q[k]) && guard <= num_old;
-         h = nextHullEdge(h), ++guard)
-      visit(h);
-    for (HullEdge h = previousHullEdge(exit);
-         h.triangle >= 0 && visible(h, q[k]) && guard <= 2 * num_old + 1;
-         h = previousHullEdge(h), ++guard)
-      visit(h);
+    for (const bool forward : {true, false})
+      for (HullEdge h = nextHullEdge(exit, forward);
+           h.triangle >= 0 && visible(h, q[k]) && guard <= 2 * num_old + 1;
+           h = nextHullEdge(h, forward), ++guard)
+        visit(h);
   }
 
   // 2. The new numbering: the union in lexicographic order.
