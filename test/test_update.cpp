@@ -311,3 +311,27 @@ TEST(SelectiveSegmentationUpdate, NothingNewChangesNothing)
   EXPECT_EQ(seg.getUpdateStatistics().new_triangles, 0u);
   EXPECT_EQ(seg.getResult().labels, labels);
 }
+
+TEST(SelectiveSegmentationUpdate, RingNormalsAndVertexMeanEdgeTestAreUpdatedInPlace)
+{
+  // The options for noisy scans (docs/evaluation.md): 2- and 3-ring normals.
+  for (const int rings : {2, 3}) {
+    auto scan = toXYZ(*selseg_test::cubeScan(6000, 30 + rings));
+    std::mt19937 rng(rings);
+    std::shuffle(scan->begin(), scan->end(), rng);
+    const std::size_t split = scan->size() * 9 / 10;
+    Seg seg;
+    seg.setNormalRings(rings);
+    auto params = seg.getParameters();
+    params.edge_triangle_normal = pcl::selective_seg::EdgeTriangleNormal::VertexMean;
+    seg.setParameters(params);
+    const double voxel = extractFirst(seg, slice(*scan, 0, split));
+    std::vector<pcl::PointIndices> clusters;
+    ASSERT_TRUE(seg.update(*slice(*scan, split, scan->size()), clusters));
+    EXPECT_TRUE(seg.getUpdateStatistics().incremental);
+    Seg ref;
+    ref.setParameters(params);
+    reference(scan, voxel, ref);
+    expectSameResult(seg, ref);
+  }
+}

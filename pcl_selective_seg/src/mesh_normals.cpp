@@ -156,6 +156,81 @@ computeVertexNormals(std::size_t num_vertices,
                  vertex_areas[v]);
 }
 
+namespace {
+
+/** The k-ring normal of eq. 2 at vertex p: triangles met breadth first, ring by ring,
+ * each vertex's triangles taken in increasing order (incident(v, list) fills them), so
+ * the sum has the same order however the incidence is obtained. The stamps mark the
+ * vertices and triangles already met for this vertex (stamp: p + 1). */
+template <typename Incident>
+Eigen::Vector3f
+ringNormal(pcl::index_t p,
+           const std::vector<Triangle>& triangles,
+           const Vector3fVector& normals,
+           const std::vector<double>& areas,
+           int rings,
+           Incident incident,
+           std::vector<std::size_t>& vertex_stamp,
+           std::vector<std::size_t>& triangle_stamp,
+           std::vector<pcl::index_t>& frontier,
+           std::vector<pcl::index_t>& next,
+           std::vector<pcl::index_t>& around)
+{
+  const std::size_t stamp = static_cast<std::size_t>(p) + 1;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  frontier.assign(1, p);
+  vertex_stamp[p] = stamp;
+  for (int ring = 0; ring < rings && !frontier.empty(); ++ring) {
+    next.clear();
+    for (const auto v : frontier) {
+      incident(v, around);
+      for (const auto t : around) {
+        if (triangle_stamp[t] == stamp)
+          continue;
+        triangle_stamp[t] = stamp;
+        const double weight = normalWeight(areas[t], normals[t]);
+        if (weight > 0.0)
+          sum += weight * normals[t].cast<double>();
+        for (const auto u : triangles[t])
+          if (vertex_stamp[u] != stamp) {
+            vertex_stamp[u] = stamp;
+            next.push_back(u);
+          }
+      }
+    }
+    frontier.swap(next);
+  }
+  return normalizedOrNaN(sum);
+}
+
+/** The triangles around vertex v, in increasing order, found by walking the adjacency
+ * from one of them (\a first) both ways. */
+void
+starOf(pcl::index_t v,
+       pcl::index_t first,
+       const std::vector<Triangle>& triangles,
+       const std::vector<Triangle>& neighbours,
+       std::vector<pcl::index_t>& star)
+{
+  star.assign(1, first);
+  for (int way = 1; way <= 2; ++way) {
+    pcl::index_t t = first;
+    for (std::size_t guard = 0; guard < triangles.size(); ++guard) {
+      const Triangle& tri = triangles[t];
+      const int j = tri[0] == v ? 0 : (tri[1] == v ? 1 : 2);
+      t = neighbours[t][(j + way) % 3];
+      if (t < 0 || t == first)
+        break;
+      star.push_back(t);
+    }
+    if (t == first)
+      break; // around an interior vertex: one way is enough
+  }
+  std::sort(star.begin(), star.end());
+}
+
+} // namespace
+
 void
 computeVertexNormalsOverRings(std::size_t num_vertices,
                               const std::vector<Triangle>& triangles,
@@ -165,38 +240,88 @@ computeVertexNormalsOverRings(std::size_t num_vertices,
                               Vector3fVector& vertex_normals)
 {
   const Incidence incident = vertexTriangles(triangles, num_vertices);
-  // Visit stamps: a vertex or triangle is in the current neighbourhood when its stamp
-  // equals the current vertex id + 1.
   std::vector<std::size_t> vertex_stamp(num_vertices, 0),
       triangle_stamp(triangles.size(), 0);
-  std::vector<pcl::index_t> frontier, next;
+  std::vector<pcl::index_t> frontier, next, around;
+  const auto list = [&](pcl::index_t v, std::vector<pcl::index_t>& out) {
+    out.assign(incident.items.begin() + incident.offsets[v],
+               incident.items.begin() + incident.offsets[v + 1]);
+  };
   vertex_normals.resize(num_vertices);
-  for (std::size_t p = 0; p < num_vertices; ++p) {
-    const std::size_t stamp = p + 1;
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    frontier.assign(1, static_cast<pcl::index_t>(p));
-    vertex_stamp[p] = stamp;
-    for (int ring = 0; ring < rings && !frontier.empty(); ++ring) {
-      next.clear();
-      for (const auto v : frontier)
-        for (auto i = incident.offsets[v]; i < incident.offsets[v + 1]; ++i) {
-          const auto t = incident.items[i];
-          if (triangle_stamp[t] == stamp)
-            continue;
-          triangle_stamp[t] = stamp;
-          const double weight = normalWeight(areas[t], normals[t]);
-          if (weight > 0.0)
-            sum += weight * normals[t].cast<double>();
-          for (const auto u : triangles[t])
-            if (vertex_stamp[u] != stamp) {
-              vertex_stamp[u] = stamp;
-              next.push_back(u);
-            }
-        }
-      frontier.swap(next);
+  for (std::size_t p = 0; p < num_vertices; ++p)
+    vertex_normals[p] = ringNormal(static_cast<pcl::index_t>(p),
+                                   triangles,
+                                   normals,
+                                   areas,
+                                   rings,
+                                   list,
+                                   vertex_stamp,
+                                   triangle_stamp,
+                                   frontier,
+                                   next,
+                                   around);
+}
+
+void
+updateVertexNormalsOverRings(const std::vector<Triangle>& triangles,
+                             const std::vector<Triangle>& neighbours,
+                             const Vector3fVector& normals,
+                             const std::vector<double>& areas,
+                             int rings,
+                             const std::vector<pcl::index_t>& changed_triangles,
+                             Vector3fVector& vertex_normals)
+{
+  // One triangle at each vertex met, for the walks around it.
+  const std::size_t num_vertices = vertex_normals.size();
+  std::vector<pcl::index_t> some_triangle(num_vertices, -1);
+  std::vector<pcl::index_t> affected, frontier, next, star;
+  for (const auto t : changed_triangles)
+    for (const auto v : triangles[t])
+      if (some_triangle[v] < 0) {
+        some_triangle[v] = t;
+        frontier.push_back(v);
+      }
+  affected = frontier;
+  // A vertex's k-ring normal sums the triangles at its (k - 1)-ring: those within k - 1
+  // rings of a changed triangle's corner are affected.
+  for (int ring = 1; ring < rings && !frontier.empty(); ++ring) {
+    next.clear();
+    for (const auto v : frontier) {
+      starOf(v, some_triangle[v], triangles, neighbours, star);
+      for (const auto t : star)
+        for (const auto u : triangles[t])
+          if (some_triangle[u] < 0) {
+            some_triangle[u] = t;
+            next.push_back(u);
+          }
     }
-    vertex_normals[p] = normalizedOrNaN(sum);
+    affected.insert(affected.end(), next.begin(), next.end());
+    frontier.swap(next);
   }
+  // The walks reach one ring beyond the affected vertices: remember a triangle there.
+  const auto list = [&](pcl::index_t v, std::vector<pcl::index_t>& out) {
+    starOf(v, some_triangle[v], triangles, neighbours, out);
+    for (const auto t : out)
+      for (const auto u : triangles[t])
+        if (some_triangle[u] < 0)
+          some_triangle[u] = t;
+  };
+  std::vector<std::size_t> vertex_stamp(num_vertices, 0),
+      triangle_stamp(triangles.size(), 0);
+  std::vector<pcl::index_t> around;
+  std::sort(affected.begin(), affected.end());
+  for (const auto p : affected)
+    vertex_normals[p] = ringNormal(p,
+                                   triangles,
+                                   normals,
+                                   areas,
+                                   rings,
+                                   list,
+                                   vertex_stamp,
+                                   triangle_stamp,
+                                   frontier,
+                                   next,
+                                   around);
 }
 
 void
@@ -274,31 +399,14 @@ updateMeshNormals(const Vector3fVector& positions,
     std::vector<pcl::index_t> star;
 #pragma omp for schedule(static)
     for (std::ptrdiff_t k = 0; k < n_touched; ++k) {
-      // The triangles around the vertex, walked through the adjacency both ways, in
-      // increasing order as computeVertexNormals() sums them.
-      const pcl::index_t v = touched[k].first;
-      const pcl::index_t first = touched[k].second;
-      star.assign(1, first);
-      for (int way = 1; way <= 2; ++way) {
-        pcl::index_t t = first;
-        for (std::size_t guard = 0; guard < triangles.size(); ++guard) {
-          const Triangle& tri = triangles[t];
-          const int j = tri[0] == v ? 0 : (tri[1] == v ? 1 : 2);
-          t = neighbours[t][(j + way) % 3];
-          if (t < 0 || t == first)
-            break;
-          star.push_back(t);
-        }
-        if (t == first)
-          break; // around an interior vertex: one way is enough
-      }
-      std::sort(star.begin(), star.end());
+      // Its triangles in increasing order, as computeVertexNormals() sums them.
+      starOf(touched[k].first, touched[k].second, triangles, neighbours, star);
       vertexNormal(star.data(),
                    star.data() + star.size(),
                    normals,
                    areas,
-                   vertex_normals[v],
-                   vertex_areas[v]);
+                   vertex_normals[touched[k].first],
+                   vertex_areas[touched[k].first]);
     }
   }
 }

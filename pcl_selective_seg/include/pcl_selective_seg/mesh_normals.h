@@ -132,6 +132,19 @@ PCL_EXPORTS void updateMeshNormals(const Vector3fVector& positions,
                                    std::vector<double>& vertex_areas,
                                    int num_threads = 0);
 
+/** \brief After updateMeshNormals(), the k-ring vertex normals (as
+ * computeVertexNormalsOverRings() gives them, bit for bit) of the vertices whose k-ring
+ * holds a changed triangle; the others are taken as valid.
+ * \param[in,out] vertex_normals per vertex, sized for the mesh */
+PCL_EXPORTS void
+updateVertexNormalsOverRings(const std::vector<Triangle>& triangles,
+                             const std::vector<Triangle>& neighbours,
+                             const Vector3fVector& normals,
+                             const std::vector<double>& areas,
+                             int rings,
+                             const std::vector<pcl::index_t>& changed_triangles,
+                             Vector3fVector& vertex_normals);
+
 /** \brief Median 3-D length of the triangles' edges [m] (each interior edge counted
  * twice); 0 for an empty mesh. The octree's automatic minimum voxel size scales it. */
 PCL_EXPORTS double medianEdgeLength(const Vector3fVector& positions,

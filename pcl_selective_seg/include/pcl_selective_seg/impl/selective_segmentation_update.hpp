@@ -80,13 +80,12 @@ SelectiveSegmentation<PointT>::updateMesh(std::size_t first_new_point, bool& fai
   pcl::StopWatch watch;
   delaunay_.setInputCloud(input_);
   delaunay_.setIndices(indices_);
-  // In place only with the parameters and pose the mesh was made with, for the exact
-  // backends (VTK's output is not the canonical triangulation) and the paper's one-
-  // ring normals.
+  // In place only with the parameters and pose the mesh was made with, and for the
+  // exact backends (VTK's output is not the canonical triangulation).
   const bool same_mesh_parameters =
       params_.angle_quantization == mesh_params_.angle_quantization &&
       params_.max_view_incidence_angle == mesh_params_.max_view_incidence_angle &&
-      params_.normal_rings == 1 && mesh_params_.normal_rings == 1 &&
+      params_.normal_rings == mesh_params_.normal_rings &&
       params_.delaunay_backend != DelaunayBackend::Vtk &&
       mesh_params_.delaunay_backend != DelaunayBackend::Vtk &&
       delaunay_.getSensorPose().matrix() == mesh_pose_ &&
@@ -178,6 +177,14 @@ SelectiveSegmentation<PointT>::updateNormals(const DelaunayInsertion& info,
                     vertex_normals,
                     *vertex_areas,
                     params_.num_threads);
+  if (params_.normal_rings > 1)
+    updateVertexNormalsOverRings(tri.triangles,
+                                 tri.neighbours,
+                                 normals,
+                                 areas,
+                                 params_.normal_rings,
+                                 changed,
+                                 vertex_normals);
   std::vector<std::uint8_t> touched(num_vertices, 0);
   for (const auto t : changed)
     for (const auto v : tri.triangles[t])
