@@ -51,6 +51,7 @@ struct Options {
   double range_noise = 0.0005;
   double min_voxel_factor = 2.0;
   double step_scale = 1.0;
+  double window_steps = 2.0;
   pcl::selective_seg::RegionOfInterestParameters regions;
 };
 
@@ -82,10 +83,13 @@ printHelp(const char* program)
       "level A)\n"
       "  -min_voxel_factor X    finest voxel = X fine steps at the median range; 0 = "
       "automatic from the coarse scan (default 2)\n"
+      "  -window_steps X        evidence tiles of X coarse steps; 0 = "
+      "-roi_max_window_deg (default 2)\n"
       "  -step_scale S          multiply every step by S (S > 1: a quicker, coarser "
       "run; default 1)\n\n"
       "The loop sets the regions' step (the fine step), point budget and yield; the "
-      "other\nregion options apply (the budget flags are ignored):\n",
+      "other\nregion options apply (the budget flags are ignored; -roi_margin_spacings "
+      "is 0.5 here):\n",
       program);
   selseg_apps::printRegionHelp();
 }
@@ -98,7 +102,7 @@ parseOptions(int argc, char** argv, Options& opt)
     const bool known = a == "-out" || a == "-scenes" || a == "-iterations" ||
                        a == "-coarse_factor" || a == "-budget_fraction" ||
                        a == "-range_noise" || a == "-min_voxel_factor" ||
-                       a == "-step_scale" ||
+                       a == "-step_scale" || a == "-window_steps" ||
                        std::find(selseg_apps::regionFlags().begin(),
                                  selseg_apps::regionFlags().end(),
                                  a) != selseg_apps::regionFlags().end();
@@ -136,14 +140,17 @@ parseOptions(int argc, char** argv, Options& opt)
       !parseNumber(argc, argv, "-range_noise", opt.range_noise) ||
       !parseNumber(argc, argv, "-min_voxel_factor", opt.min_voxel_factor) ||
       !parseNumber(argc, argv, "-step_scale", opt.step_scale) ||
+      !parseNumber(argc, argv, "-window_steps", opt.window_steps) ||
       !selseg_apps::parseRegionOptions(argc, argv, opt.regions))
     return false;
   if (opt.iterations < 0 || opt.iterations > 100 || !(opt.coarse_factor >= 1.0) ||
       !(opt.budget_fraction > 0.0 && opt.budget_fraction <= 1.0) ||
       !(opt.range_noise >= 0.0 && opt.range_noise <= 1.0) ||
-      !(opt.min_voxel_factor >= 0.0) || !(opt.step_scale > 0.0)) {
+      !(opt.min_voxel_factor >= 0.0) || !(opt.step_scale > 0.0) ||
+      !(opt.window_steps >= 0.0)) {
     print_error("Need 0 <= iterations <= 100, coarse_factor >= 1, 0 < budget_fraction "
-                "<= 1, 0 <= range_noise <= 1, min_voxel_factor >= 0, step_scale > 0.\n");
+                "<= 1, 0 <= range_noise <= 1, min_voxel_factor >= 0, step_scale > 0, "
+                "window_steps >= 0.\n");
     return false;
   }
   return true;
@@ -246,6 +253,7 @@ runScene(const Options& opt, const std::string& name, std::string& table)
   loop.iterations = opt.iterations;
   loop.min_voxel_factor = opt.min_voxel_factor;
   loop.regions = opt.regions;
+  loop.window_steps = opt.window_steps;
   loop.point_budget =
       static_cast<std::size_t>(opt.budget_fraction * static_cast<double>(dense_points));
   std::vector<RegionOfInterest> scanned;
@@ -342,6 +350,9 @@ main(int argc, char** argv)
     return argc < 2 ? kUsageError : 0;
   }
   Options opt;
+  // The loop's windows: half a spacing of margin (the default of one spacing is for a
+  // single finer look without follow-up rounds).
+  opt.regions.margin_spacings = 0.5;
   if (!parseOptions(argc, argv, opt))
     return kUsageError;
   std::string table =

@@ -34,6 +34,7 @@ regionFlags()
                                                  "-roi_margin_spacings",
                                                  "-roi_small_points",
                                                  "-roi_min_component",
+                                                 "-roi_valid_edges",
                                                  "-roi_sparse_factor",
                                                  "-roi_leaf_sigma_deg",
                                                  "-roi_weights"};
@@ -63,14 +64,18 @@ printRegionHelp()
       "  -roi_margin_spacings X   margin in units of the local spacing (default %g)\n"
       "  -roi_small_points N      segments with fewer points are evidence; 0 = off "
       "(default %zu)\n"
+      "  -roi_valid_edges 0|1     valid edge triangles (segment borders) are "
+      "transition evidence too (default %d)\n"
       "  -roi_min_component N     evidence in mesh-connected groups of fewer vertices "
       "is ignored (default %zu)\n"
       "  -roi_sparse_factor X     spacing above X times the median is evidence; 0 = "
       "off (default %g)\n"
       "  -roi_leaf_sigma_deg X    finest leaves with a larger normal spread are "
       "evidence; 0 = off (default %g)\n"
-      "  -roi_weights T,S,P       priority weights of transition, small segment and "
-      "sparse evidence (default %g,%g,%g)\n\n",
+      "  -roi_weights I,L,V,S,P   priority weights of transition evidence from "
+      "invalid edges, leaves, valid\n"
+      "                           edges, and of small-segment and sparse evidence "
+      "(default %g,%g,%g,%g,%g)\n\n",
       d.max_solid_angle,
       d.max_points,
       d.max_regions,
@@ -82,10 +87,13 @@ printRegionHelp()
       d.margin / kDeg,
       d.margin_spacings,
       d.small_segment_points,
+      d.use_valid_edges ? 1 : 0,
       d.min_component_vertices,
       d.sparse_factor,
       d.leaf_sigma_threshold / kDeg,
       d.transition_weight,
+      d.leaf_weight,
+      d.valid_edge_weight,
       d.small_segment_weight,
       d.sparse_weight);
 }
@@ -101,7 +109,8 @@ parseRegionOptions(int argc,
   double max_points = static_cast<double>(p.max_points),
          max_regions = static_cast<double>(p.max_regions),
          small = static_cast<double>(p.small_segment_points),
-         component = static_cast<double>(p.min_component_vertices);
+         component = static_cast<double>(p.min_component_vertices),
+         valid_edges = p.use_valid_edges ? 1.0 : 0.0;
   if (!parseNumber(argc, argv, "-roi_max_sr", p.max_solid_angle) ||
       !parseNumber(argc, argv, "-roi_max_points", max_points) ||
       !parseNumber(argc, argv, "-roi_max_regions", max_regions) ||
@@ -114,6 +123,7 @@ parseRegionOptions(int argc,
       !parseNumber(argc, argv, "-roi_margin_spacings", p.margin_spacings) ||
       !parseNumber(argc, argv, "-roi_small_points", small) ||
       !parseNumber(argc, argv, "-roi_min_component", component) ||
+      !parseNumber(argc, argv, "-roi_valid_edges", valid_edges) ||
       !parseNumber(argc, argv, "-roi_sparse_factor", p.sparse_factor) ||
       !parseNumber(argc, argv, "-roi_leaf_sigma_deg", sigma))
     return false;
@@ -128,18 +138,25 @@ parseRegionOptions(int argc,
   if (pcl::console::find_argument(argc, argv, "-roi_weights") >= 0) {
     std::vector<double> w;
     if (pcl::console::parse_x_arguments(argc, argv, "-roi_weights", w) < 0 ||
-        w.size() != 3) {
-      pcl::console::print_error("Option -roi_weights needs 3 comma-separated numbers.\n");
+        w.size() != 5) {
+      pcl::console::print_error("Option -roi_weights needs 5 comma-separated numbers.\n");
       return false;
     }
     p.transition_weight = w[0];
-    p.small_segment_weight = w[1];
-    p.sparse_weight = w[2];
+    p.leaf_weight = w[1];
+    p.valid_edge_weight = w[2];
+    p.small_segment_weight = w[3];
+    p.sparse_weight = w[4];
   }
   p.max_points = static_cast<std::size_t>(max_points);
   p.max_regions = static_cast<std::size_t>(max_regions);
   p.small_segment_points = static_cast<std::size_t>(small);
   p.min_component_vertices = static_cast<std::size_t>(component);
+  if (valid_edges != 0.0 && valid_edges != 1.0) {
+    pcl::console::print_error("Option -roi_valid_edges needs 0 or 1.\n");
+    return false;
+  }
+  p.use_valid_edges = valid_edges == 1.0;
   p.target_step = step * kDeg;
   p.max_window_size = max_window * kDeg;
   p.min_window_size = min_window * kDeg;

@@ -84,6 +84,15 @@ overlapArea(const Window& a, const Window& b)
   return w > 0.0 && h > 0.0 ? w * h : 0.0;
 }
 
+/** Whether two windows overlap or share a stretch of their borders. */
+bool
+meet(const Window& a, const Window& b)
+{
+  const double w = std::min(a.theta_max, b.theta_max) - std::max(a.theta_min, b.theta_min);
+  const double h = std::min(a.phi_max, b.phi_max) - std::max(a.phi_min, b.phi_min);
+  return w >= 0.0 && h >= 0.0 && (w > 0.0 || h > 0.0);
+}
+
 Window
 boundingWindow(const Window& a, const Window& b)
 {
@@ -198,16 +207,31 @@ findEvidence(const SegmentationResult& result,
              const Eigen::Affine3d& cloud_to_sensor,
              const std::vector<Eigen::Vector2d>& angles,
              const std::vector<double>& spacing,
-             const RegionOfInterestParameters& p)
+             const RegionOfInterestParameters& p,
+             std::vector<double>& transition_strength)
 {
   const std::size_t nv = tri.vertex_point.size();
   std::vector<std::uint8_t> kinds(nv, 0);
-  if (p.use_invalid_edges)
-    for (std::size_t t = 0; t < tri.triangles.size(); ++t)
-      if (result.mesh.classes[t] == TriangleClass::InvalidEdge)
-        for (const auto v : tri.triangles[t])
-          kinds[v] |= kTransition;
-  markLeafEvidence(result, tri, cloud_to_sensor, p.leaf_sigma_threshold, kinds);
+  // The strength of transition evidence: invalid edges, then leaves, then valid edges.
+  transition_strength.assign(nv, 0.0);
+  const auto mark = [&](std::size_t v, double weight) {
+    kinds[v] |= kTransition;
+    transition_strength[v] = std::max(transition_strength[v], weight);
+  };
+  for (std::size_t t = 0; t < tri.triangles.size(); ++t) {
+    const auto c = result.mesh.classes[t];
+    if (p.use_invalid_edges && c == TriangleClass::InvalidEdge)
+      for (const auto v : tri.triangles[t])
+        mark(static_cast<std::size_t>(v), p.transition_weight);
+    else if (p.use_valid_edges && c == TriangleClass::ValidEdge)
+      for (const auto v : tri.triangles[t])
+        mark(static_cast<std::size_t>(v), p.valid_edge_weight);
+  }
+  std::vector<std::uint8_t> leaf(nv, 0);
+  markLeafEvidence(result, tri, cloud_to_sensor, p.leaf_sigma_threshold, leaf);
+  for (std::size_t v = 0; v < nv; ++v)
+    if (leaf[v])
+      mark(v, p.leaf_weight);
   if (p.small_segment_points > 0)
     for (std::size_t v = 0; v < nv; ++v) {
       const std::uint32_t label = result.labels[tri.vertex_point[v]];
@@ -269,18 +293,27 @@ makeTileWindows(const SphericalTriangulation& tri,
         if ((kinds[a] & kind) && (kinds[b] & kind))
           sets.unite(static_cast<std::size_t>(a), static_cast<std::size_t>(b));
       }
+    // Tiles start at the component's smallest angles: a component that fits in one
+    // tile gives one window.
     std::vector<std::size_t> size(nv, 0);
+    std::vector<Eigen::Vector2d> start(nv, Eigen::Vector2d::Constant(kHalfPi));
     for (std::size_t v = 0; v < nv; ++v)
-      if (kinds[v] & kind)
-        ++size[sets.find(v)];
-    for (std::size_t v = 0; v < nv; ++v)
-      if ((kinds[v] & kind) && size[sets.find(v)] >= p.min_component_vertices)
-        entries.emplace_back(
-            kind,
-            sets.find(v),
-            static_cast<std::int64_t>(std::floor(angles[v].x() / p.max_window_size)),
-            static_cast<std::int64_t>(std::floor(angles[v].y() / p.max_window_size)),
-            static_cast<pcl::index_t>(v));
+      if (kinds[v] & kind) {
+        const std::size_t root = sets.find(v);
+        ++size[root];
+        start[root] = start[root].cwiseMin(angles[v]);
+      }
+    for (std::size_t v = 0; v < nv; ++v) {
+      const std::size_t root = sets.find(v);
+      if (!(kinds[v] & kind) || size[root] < p.min_component_vertices)
+        continue;
+      const Eigen::Vector2d tile = (angles[v] - start[root]) / p.max_window_size;
+      entries.emplace_back(kind,
+                           root,
+                           static_cast<std::int64_t>(std::floor(tile.x())),
+                           static_cast<std::int64_t>(std::floor(tile.y())),
+                           static_cast<pcl::index_t>(v));
+    }
   }
   std::sort(entries.begin(), entries.end());
   std::vector<Window> windows;
@@ -341,7 +374,7 @@ mergeWindows(std::vector<Window>& windows, const RegionOfInterestParameters& p)
         Window u = boundingWindow(a, b);
         const bool fits = u.width() <= std::max({p.max_window_size, a.width(), b.width()}) &&
                           u.height() <= std::max({p.max_window_size, a.height(), b.height()});
-        if (common > 0.0 && fits &&
+        if (meet(a, b) && fits &&
             u.area() <= p.merge_area_ratio * (a.area() + b.area() - common)) {
           u.reasons = a.reasons | b.reasons;
           u.evidence = std::move(a.evidence);
@@ -358,11 +391,11 @@ mergeWindows(std::vector<Window>& windows, const RegionOfInterestParameters& p)
 }
 
 double
-kindWeight(std::uint8_t kinds, const RegionOfInterestParameters& p)
+kindWeight(std::uint8_t kinds, double transition_strength, const RegionOfInterestParameters& p)
 {
   double w = 0.0;
   if (kinds & kTransition)
-    w = std::max(w, p.transition_weight);
+    w = std::max(w, transition_strength);
   if (kinds & kSmallSegment)
     w = std::max(w, p.small_segment_weight);
   if (kinds & kSparse)
@@ -413,6 +446,10 @@ RegionOfInterestParameters::validate(std::string* why) const
     return reject(why, "min_refinement", min_refinement, "[1, inf)");
   if (!finiteAtLeast(transition_weight, 0.0))
     return reject(why, "transition_weight", transition_weight, "[0, inf)");
+  if (!finiteAtLeast(leaf_weight, 0.0))
+    return reject(why, "leaf_weight", leaf_weight, "[0, inf)");
+  if (!finiteAtLeast(valid_edge_weight, 0.0))
+    return reject(why, "valid_edge_weight", valid_edge_weight, "[0, inf)");
   if (!finiteAtLeast(small_segment_weight, 0.0))
     return reject(why, "small_segment_weight", small_segment_weight, "[0, inf)");
   if (!finiteAtLeast(sparse_weight, 0.0))
@@ -486,8 +523,9 @@ computeRegionsOfInterest(const SegmentationResult& result,
                 tri.angle_quantization;
   const std::vector<double> spacing = vertexSpacing(tri, angles);
   const Eigen::Affine3d to_cloud = sensor_to_cloud.cast<double>();
+  std::vector<double> strength;
   const std::vector<std::uint8_t> kinds =
-      findEvidence(result, tri, to_cloud.inverse(), angles, spacing, p);
+      findEvidence(result, tri, to_cloud.inverse(), angles, spacing, p, strength);
   for (const auto k : kinds) {
     st.transition_vertices += (k & kTransition) != 0;
     st.small_segment_vertices += (k & kSmallSegment) != 0;
@@ -507,7 +545,7 @@ computeRegionsOfInterest(const SegmentationResult& result,
     for (const auto v : ev) {
       local.push_back(spacing[v]);
       const double s2 = spacing[v] * spacing[v];
-      weighted += kindWeight(kinds[v], p) * s2;
+      weighted += kindWeight(kinds[v], strength[v], p) * s2;
       covered += s2;
     }
     RegionOfInterest r;

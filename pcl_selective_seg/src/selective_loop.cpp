@@ -176,10 +176,11 @@ runSelectiveLoop(const SimulationSetup& setup,
   if (!(params.fine_step > 0.0) || !std::isfinite(params.fine_step) ||
       !(params.coarse_factor >= 1.0) || !std::isfinite(params.coarse_factor) ||
       params.iterations < 0 || params.point_budget == 0 ||
-      !(params.min_voxel_factor >= 0.0) || !(params.boundary_edge_steps > 0.0))
+      !(params.min_voxel_factor >= 0.0) || !(params.boundary_edge_steps > 0.0) ||
+      !(params.window_steps >= 0.0) || !std::isfinite(params.window_steps))
     return fail("invalid parameters: need fine_step > 0 [rad], coarse_factor >= 1, "
                 "iterations >= 0, point_budget > 0, min_voxel_factor >= 0, "
-                "boundary_edge_steps > 0");
+                "boundary_edge_steps > 0, window_steps >= 0");
   SensorSimulator simulator;
   if (!simulator.setParameters(setup.sensor))
     return fail("invalid sensor parameters (reason above)");
@@ -192,7 +193,7 @@ runSelectiveLoop(const SimulationSetup& setup,
     return fail("the coarse scan failed (reason above)");
   if (cloud->empty())
     return fail("the coarse scan has no point");
-  const double yield =
+  double yield =
       std::clamp(static_cast<double>(cloud->size()) /
                      static_cast<double>(std::max<std::size_t>(details.candidates, 1)),
                  1e-3,
@@ -230,6 +231,9 @@ runSelectiveLoop(const SimulationSetup& setup,
     if (round < params.iterations && score.points < params.point_budget) {
       RegionOfInterestParameters roi = params.regions;
       roi.target_step = params.fine_step;
+      if (params.window_steps > 0.0)
+        roi.max_window_size = std::min(M_PI, params.window_steps * coarse_step);
+      roi.min_window_size = std::min(roi.min_window_size, roi.max_window_size);
       roi.sample_yield = yield;
       roi.max_points =
           std::max<std::size_t>(1,
@@ -242,23 +246,17 @@ runSelectiveLoop(const SimulationSetup& setup,
         return fail("computing the regions of interest failed (reason above)");
       score.seconds += watch.getTimeSeconds();
     }
-    rounds.push_back(score);
-    if (observer) {
-      LoopRound r;
-      r.iteration = round;
-      r.cloud = cloud.get();
-      r.result = &seg.getResult();
-      r.regions = &regions;
-      r.region_stats = stats;
-      r.score = score;
-      observer(r);
-    }
-    if (regions.empty())
-      break;
+    // Windows in priority order while the points actually acquired leave room for the
+    // window's estimate: the budget holds up to one window's estimation error.
     pcl::PointCloud<pcl::PointXYZL> fresh;
-    score.windows = regions.size();
+    std::vector<RegionOfInterest> scanned;
+    double solid_angle = 0.0;
     for (std::size_t k = 0; k < regions.size(); ++k) {
       const auto& r = regions[k];
+      const std::size_t acquired = cloud->size() + fresh.size();
+      if (acquired + r.estimated_points > params.point_budget)
+        continue;
+      scanned.push_back(r);
       ScanWindow w;
       w.theta_min = r.theta_min;
       w.theta_max = r.theta_max;
@@ -270,8 +268,32 @@ runSelectiveLoop(const SimulationSetup& setup,
       if (!simulator.simulateWindow(setup.scene, w, part))
         return fail("a window scan failed (reason above)");
       fresh += part;
-      score.scanned_solid_angle += r.solid_angle;
+      solid_angle += r.solid_angle;
     }
+    regions = scanned;
+    rounds.push_back(score);
+    if (observer) {
+      LoopRound r;
+      r.iteration = round;
+      r.cloud = cloud.get();
+      r.result = &seg.getResult();
+      r.regions = &regions;
+      r.region_stats = stats;
+      r.score = score;
+      observer(r);
+    }
+    if (scanned.empty())
+      break;
+    score.windows = scanned.size();
+    score.scanned_solid_angle += solid_angle;
+    std::size_t estimated = 0;
+    for (const auto& r : scanned)
+      estimated += r.estimated_points;
+    if (estimated > 0)
+      yield = std::clamp(yield * static_cast<double>(fresh.size()) /
+                             static_cast<double>(estimated),
+                         1e-3,
+                         1.0);
     fresh.width = static_cast<std::uint32_t>(fresh.size());
     fresh.height = 1;
     if (!seg.update(fresh, clusters))

@@ -43,6 +43,9 @@ struct PCL_EXPORTS RegionOfInterestParameters {
   // --- what counts as evidence ---
   /** \brief Invalid edge triangles are transition evidence. */
   bool use_invalid_edges = true;
+  /** \brief Valid edge triangles (segment borders the surface continues across) are
+   * transition evidence too (with use_invalid_edges). */
+  bool use_valid_edges = false;
   /** \brief Finest-size octree leaves (the smallest leaf size of the result) whose
    * sigma_theta or sigma_phi exceeds this are transition evidence [rad]; the
    * segmentation's split threshold (max_normal_std_dev, 7.6 deg by default) is the
@@ -74,7 +77,7 @@ struct PCL_EXPORTS RegionOfInterestParameters {
   /** \brief Margin added around the evidence in units of its current angular spacing
    * (the true edge lies anywhere between the coarse samples). Valid: >= 0, finite. */
   double margin_spacings = 1.0;
-  /** \brief Two overlapping windows merge when their bounding window is at most this
+  /** \brief Two overlapping (or edge-sharing) windows merge when their bounding window is at most this
    * many times the area they cover together (and fits max_window_size): overlaps are
    * removed where that wastes little. Valid: >= 1, finite. */
   double merge_area_ratio = 1.25;
@@ -92,7 +95,12 @@ struct PCL_EXPORTS RegionOfInterestParameters {
   double min_refinement = 1.5;
 
   // --- priority ---
-  double transition_weight = 1.0;    ///< weight of transition evidence, >= 0
+  /** \brief Weight of transition evidence from invalid edge triangles, >= 0. */
+  double transition_weight = 1.0;
+  /** \brief Weight of transition evidence from finest octree leaves only, >= 0. */
+  double leaf_weight = 0.7;
+  /** \brief Weight of transition evidence from valid edge triangles only, >= 0. */
+  double valid_edge_weight = 0.5;
   double small_segment_weight = 0.6; ///< weight of small-segment evidence, >= 0
   double sparse_weight = 0.3;        ///< weight of sparse evidence, >= 0
 
@@ -162,7 +170,7 @@ PCL_EXPORTS double windowSolidAngle(double theta_min,
 /** \brief Regions of interest of a segmentation for a finer acquisition.
  *
  * Evidence vertices (RegionReason) are grouped by kind into mesh-connected components,
- * each component is cut into tiles of max_window_size on a fixed angular grid, each
+ * each component is cut into tiles of max_window_size from its smallest angles, each
  * tile gives a window (its vertices' angles plus margins), overlapping windows merge
  * (merge_area_ratio), windows already sampled at about the suggested step are dropped,
  * and the budget picks windows greedily by priority. Output order: priority

@@ -87,8 +87,13 @@ struct PCL_EXPORTS SelectiveLoopParameters {
   /** \brief Predicted boundary edges longer than this many coarse steps are left out
    * of boundary accuracy (edges across holes). */
   double boundary_edge_steps = 4.0;
+  /** \brief Evidence tiles (RegionOfInterestParameters::max_window_size) of this
+   * many coarse steps; 0: keep regions.max_window_size. */
+  double window_steps = 2.0;
   SelectiveSegmentationParameters segmentation;
-  /** \brief target_step, max_points and sample_yield are set by the loop. */
+  /** \brief The regions of interest; target_step, max_points and sample_yield are set
+   * by the loop (the yield from the coarse scan, then corrected each round by the
+   * points a round's windows actually returned over their estimate). */
   RegionOfInterestParameters regions;
 };
 
@@ -97,7 +102,8 @@ struct LoopRound {
   int iteration = 0; ///< 0 = the coarse scan
   const pcl::PointCloud<pcl::PointXYZL>* cloud = nullptr; ///< everything acquired
   const SegmentationResult* result = nullptr;             ///< its segmentation
-  /** The windows chosen after this round (scanned in the next one). */
+  /** The windows chosen after this round and scanned for the next one (those of
+   * computeRegionsOfInterest() that the points acquired so far left room for). */
   const std::vector<RegionOfInterest>* regions = nullptr;
   RegionOfInterestStats region_stats; ///< of computeRegionsOfInterest() this round
   ScanScore score;
