@@ -556,32 +556,41 @@ computeRegionsOfInterest(const SegmentationResult& result,
     r.reasons = w.reasons;
     r.num_evidence = ev.size();
     r.current_step = median(local);
-    r.suggested_step = p.target_step > 0.0 ? p.target_step : r.current_step / p.refinement_factor;
-    if (!(r.suggested_step > 0.0) || r.current_step < p.min_refinement * r.suggested_step) {
+    r.suggested_step =
+        p.target_step > 0.0 ? p.target_step : r.current_step / p.refinement_factor;
+    if (!(r.suggested_step > 0.0) ||
+        r.current_step < p.min_refinement * r.suggested_step) {
       ++st.already_fine;
       continue;
     }
     const double area = w.area();
-    r.priority = weighted / std::max(area, covered) * (1.0 - r.suggested_step / r.current_step);
     r.solid_angle = windowSolidAngle(r.theta_min, r.theta_max, r.phi_min, r.phi_max);
     r.estimated_points = static_cast<std::size_t>(
         std::llround(p.sample_yield * area / (r.suggested_step * r.suggested_step)));
     // Vertices are numbered in increasing quantized theta: the window's are a range.
     const double q = tri.angle_quantization;
     const auto first = std::lower_bound(
-        tri.vertex_angles.begin(), tri.vertex_angles.end(), r.theta_min / q,
+        tri.vertex_angles.begin(),
+        tri.vertex_angles.end(),
+        r.theta_min / q,
         [](const QuantizedPoint& a, double t) { return a[0] < t; });
     r.box_min = Eigen::Vector3f::Constant(std::numeric_limits<float>::max());
     r.box_max = Eigen::Vector3f::Constant(std::numeric_limits<float>::lowest());
-    for (auto it = first; it != tri.vertex_angles.end() && (*it)[0] <= r.theta_max / q; ++it) {
+    for (auto it = first; it != tri.vertex_angles.end() && (*it)[0] <= r.theta_max / q;
+         ++it) {
       if ((*it)[1] < r.phi_min / q || (*it)[1] > r.phi_max / q)
         continue;
       const auto v = static_cast<std::size_t>(it - tri.vertex_angles.begin());
-      const Eigen::Vector3f x = (to_cloud * tri.vertex_positions[v].cast<double>()).cast<float>();
+      const Eigen::Vector3f x =
+          (to_cloud * tri.vertex_positions[v].cast<double>()).cast<float>();
       r.box_min = r.box_min.cwiseMin(x);
       r.box_max = r.box_max.cwiseMax(x);
       ++r.num_points;
     }
+    // The weighted share of the window's area its evidence stands for (each vertex
+    // spacing^2), times the share of new samples a scan at the suggested step brings.
+    r.priority = weighted / std::max(area, covered) *
+                 (1.0 - r.suggested_step / r.current_step);
     candidates.push_back(r);
   }
   std::sort(candidates.begin(), candidates.end(), [](const auto& a, const auto& b) {

@@ -134,9 +134,11 @@ struct RegionOfInterest {
    * angles lie in the window [m] (empty box, min > max, when none does). */
   Eigen::Vector3f box_min = Eigen::Vector3f::Zero();
   Eigen::Vector3f box_max = Eigen::Vector3f::Zero();
-  /** Weighted evidence per unit area of the window times the fraction of new samples
-   * a scan at the suggested step brings, 1 - suggested_step / current_step; in
-   * [0, largest weight]. */
+  /** The weighted share of the window's area that its evidence stands for (each
+   * evidence vertex for its spacing squared: sum of weight x spacing^2 over
+   * max(window area, sum of spacing^2)) times the share of new samples a scan at the
+   * suggested step brings, 1 - suggested_step / current_step; in [0, largest
+   * weight]. */
   double priority = 0.0;
   double suggested_step = 0.0; ///< angular step of the finer scan [rad]
   double current_step = 0.0;   ///< median angular spacing of its evidence now [rad]
