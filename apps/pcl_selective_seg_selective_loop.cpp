@@ -70,7 +70,8 @@ void
 printHelp(const char* program)
 {
   print_info(
-      "The simulated coarse-to-fine loop of selective sensing against uniform scans.\n\n"
+      "The simulated coarse-to-fine loop of selective sensing against uniform "
+      "scans.\n\n"
       "Usage: %s -out FOLDER [options]\n"
       "  -out FOLDER            where table.md, <scene>.dat, clouds and windows go "
       "(must exist)\n"
@@ -178,25 +179,26 @@ tableRow(const std::string& scene,
          std::size_t dense_points)
 {
   char line[512];
-  std::snprintf(line,
-                sizeof(line),
-                "| %s | %s | %zu | %.0f%% | %.3f | %.2f | %.2f | %.2f | %zu | %zu/%zu/%zu/"
-                "%zu/%zu | %.2f%% |\n",
-                scene.c_str(),
-                strategy.c_str(),
-                s.points,
-                100.0 * static_cast<double>(s.points) / static_cast<double>(dense_points),
-                s.seconds,
-                1000.0 * s.accuracy.mean,
-                1000.0 * s.accuracy.p90,
-                1000.0 * s.spurious.mean,
-                s.segments,
-                s.hoover.correct_detections,
-                s.hoover.over_segmentations,
-                s.hoover.under_segmentations,
-                s.hoover.missed,
-                s.hoover.noise,
-                100.0 * s.under_segmentation);
+  std::snprintf(
+      line,
+      sizeof(line),
+      "| %s | %s | %zu | %.0f%% | %.3f | %.2f | %.2f | %.2f | %zu | %zu/%zu/%zu/"
+      "%zu/%zu | %.2f%% |\n",
+      scene.c_str(),
+      strategy.c_str(),
+      s.points,
+      100.0 * static_cast<double>(s.points) / static_cast<double>(dense_points),
+      s.seconds,
+      1000.0 * s.accuracy.mean,
+      1000.0 * s.accuracy.p90,
+      1000.0 * s.spurious.mean,
+      s.segments,
+      s.hoover.correct_detections,
+      s.hoover.over_segmentations,
+      s.hoover.under_segmentations,
+      s.hoover.missed,
+      s.hoover.noise,
+      100.0 * s.under_segmentation);
   return line;
 }
 
@@ -324,17 +326,20 @@ runScene(const Options& opt, const std::string& name, std::string& table)
   voxel.close();
   dat.close();
   if (!files_ok || !voxel || !dat) {
-    print_error("Cannot write the files of %s under '%s'.\n", name.c_str(), opt.out.c_str());
+    print_error(
+        "Cannot write the files of %s under '%s'.\n", name.c_str(), opt.out.c_str());
     return false;
   }
   for (std::size_t i = 0; i < uniform.size(); ++i) {
     char label[64];
-    std::snprintf(label, sizeof(label), "uniform, step %.2f mrad", 1000.0 * factors[i] * fine);
+    std::snprintf(
+        label, sizeof(label), "uniform, step %.2f mrad", 1000.0 * factors[i] * fine);
     table += tableRow(name, label, uniform[i], dense_points);
   }
   for (std::size_t i = 0; i < rounds.size(); ++i)
     table += tableRow(name,
-                      i == 0 ? "selective, coarse scan" : "selective, round " + std::to_string(i),
+                      i == 0 ? "selective, coarse scan"
+                             : "selective, round " + std::to_string(i),
                       rounds[i],
                       dense_points);
   return true;
@@ -356,7 +361,8 @@ main(int argc, char** argv)
   if (!parseOptions(argc, argv, opt))
     return kUsageError;
   std::string table =
-      "| scene | strategy | points | of dense | time (s) | boundary accuracy, mean (mm) "
+      "| scene | strategy | points | of dense | time (s) | boundary accuracy, mean "
+      "(mm) "
       "| p90 (mm) | spurious, mean (mm) | segments | correct/over/under/missed/noise "
       "| under-seg. error |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& scene : opt.scenes)

@@ -337,8 +337,7 @@ segment(const Options& opt, Scene& scene)
     print_info("Regions of interest: %zu chosen of %zu candidates\n",
                stats.selected,
                stats.candidates);
-  }
-  else if (!opt.roi_json.empty()) {
+  } else if (!opt.roi_json.empty()) {
     std::string error;
     if (!selseg_apps::readRegionsJson(opt.roi_json, scene.regions, error)) {
       print_error("%s\n", error.c_str());
@@ -542,9 +541,11 @@ buildRegions(const Scene& scene)
     ids[4] = ids[0];
     cells->InsertNextCell(5, ids);
     const std::array<unsigned char, 3> rgb =
-        (r.reasons & pcl::selective_seg::kTransition)     ? std::array<unsigned char, 3>{255, 230, 0}
-        : (r.reasons & pcl::selective_seg::kSmallSegment) ? std::array<unsigned char, 3>{255, 0, 255}
-                                                          : std::array<unsigned char, 3>{0, 230, 255};
+        (r.reasons & pcl::selective_seg::kTransition)
+            ? std::array<unsigned char, 3>{255, 230, 0}
+        : (r.reasons & pcl::selective_seg::kSmallSegment)
+            ? std::array<unsigned char, 3>{255, 0, 255}
+            : std::array<unsigned char, 3>{0, 230, 255};
     colors->InsertNextTypedTuple(rgb.data());
   }
   auto data = PolyData::New();
@@ -684,13 +685,13 @@ SegmentationViewer::SegmentationViewer(const Scene& scene,
   actors_[kRegions]->GetProperty()->SetLineWidth(2.0f);
   actors_[kOctree]->GetProperty()->SetEdgeColor(0.1, 0.1, 0.1);
   setOctreeWireframe(opt.octree_wireframe);
-  summary_ = std::to_string(scene.result.segments.size()) + " segments, " +
-             std::to_string(scene.result.leaves.size()) + " octree leaves, " +
-             std::to_string(scene.result.mesh.triangles.size()) + " triangles" +
-             (scene.regions.empty() && opt.roi_json.empty() && !opt.roi
-                  ? std::string()
-                  : ", " + std::to_string(scene.regions.size()) +
-                        " regions of interest");
+  summary_ =
+      std::to_string(scene.result.segments.size()) + " segments, " +
+      std::to_string(scene.result.leaves.size()) + " octree leaves, " +
+      std::to_string(scene.result.mesh.triangles.size()) + " triangles" +
+      (scene.regions.empty() && opt.roi_json.empty() && !opt.roi
+           ? std::string()
+           : ", " + std::to_string(scene.regions.size()) + " regions of interest");
   updateLegend();
   setSensorCamera();
   if (!offscreen)

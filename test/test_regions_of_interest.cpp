@@ -52,10 +52,14 @@ makeGrid(int columns,
       g.tri.vertex_angles.push_back({static_cast<std::int32_t>(std::lround(theta / q)),
                                      static_cast<std::int32_t>(std::lround(phi / q))});
       g.tri.vertex_positions.emplace_back(std::tan(theta), std::tan(phi), 1.0f);
-      g.tri.vertex_point.push_back(static_cast<pcl::index_t>(g.tri.vertex_point.size()));
-      g.tri.point_vertex.push_back(static_cast<pcl::index_t>(g.tri.point_vertex.size()));
+      g.tri.vertex_point.push_back(
+          static_cast<pcl::index_t>(g.tri.vertex_point.size()));
+      g.tri.point_vertex.push_back(
+          static_cast<pcl::index_t>(g.tri.point_vertex.size()));
     }
-  const auto id = [rows](int c, int r) { return static_cast<pcl::index_t>(c * rows + r); };
+  const auto id = [rows](int c, int r) {
+    return static_cast<pcl::index_t>(c * rows + r);
+  };
   std::vector<bool> invalid;
   for (int c = 0; c + 1 < columns; ++c)
     for (int r = 0; r + 1 < rows; ++r) {
@@ -64,7 +68,8 @@ makeGrid(int columns,
       invalid.push_back(r == edge_row);
       invalid.push_back(r == edge_row);
     }
-  computeTriangleNeighbours(g.tri.triangles, g.tri.vertex_point.size(), g.tri.neighbours);
+  computeTriangleNeighbours(
+      g.tri.triangles, g.tri.vertex_point.size(), g.tri.neighbours);
   const std::size_t n = g.tri.vertex_point.size();
   g.result.labels.assign(n, 1);
   std::size_t small = 0;
@@ -136,7 +141,8 @@ TEST(RegionsOfInterest, SolidAngleOfAWindow)
   EXPECT_NEAR(windowSolidAngle(-0.001, 0.001, 0.0, 0.002), 4e-6, 1e-11);
   // Additive over a split window.
   EXPECT_NEAR(windowSolidAngle(0.1, 0.3, 0.2, 0.5),
-              windowSolidAngle(0.1, 0.2, 0.2, 0.5) + windowSolidAngle(0.2, 0.3, 0.2, 0.5),
+              windowSolidAngle(0.1, 0.2, 0.2, 0.5) +
+                  windowSolidAngle(0.2, 0.3, 0.2, 0.5),
               1e-12);
 }
 
@@ -180,17 +186,24 @@ TEST(RegionsOfInterest, EmptyAndMismatchedInput)
 
   GridMesh g = makeGrid(10, 6, 0.01, 2);
   g.result.labels.pop_back();
-  EXPECT_FALSE(computeRegionsOfInterest(
-      g.result, g.tri, Eigen::Affine3f::Identity(), RegionOfInterestParameters(), regions));
+  EXPECT_FALSE(computeRegionsOfInterest(g.result,
+                                        g.tri,
+                                        Eigen::Affine3f::Identity(),
+                                        RegionOfInterestParameters(),
+                                        regions));
   g = makeGrid(10, 6, 0.01, 2);
   g.result.mesh.classes.pop_back();
-  EXPECT_FALSE(computeRegionsOfInterest(
-      g.result, g.tri, Eigen::Affine3f::Identity(), RegionOfInterestParameters(), regions));
+  EXPECT_FALSE(computeRegionsOfInterest(g.result,
+                                        g.tri,
+                                        Eigen::Affine3f::Identity(),
+                                        RegionOfInterestParameters(),
+                                        regions));
   // A segmentation without any evidence proposes nothing.
   g = makeGrid(10, 6, 0.01, -1);
   RegionOfInterestParameters p;
   p.sparse_factor = 0.0;
-  EXPECT_TRUE(computeRegionsOfInterest(g.result, g.tri, Eigen::Affine3f::Identity(), p, regions));
+  EXPECT_TRUE(computeRegionsOfInterest(
+      g.result, g.tri, Eigen::Affine3f::Identity(), p, regions));
   EXPECT_TRUE(regions.empty());
 }
 
@@ -223,7 +236,8 @@ TEST(RegionsOfInterest, WindowOverABandOfInvalidEdgeTriangles)
   EXPECT_NEAR(r.phi_min, -0.01 - 0.005, 1e-6);
   EXPECT_NEAR(r.phi_max, 0.0 + 0.005, 1e-6);
   EXPECT_NEAR(r.solid_angle, windowSolidAngle(-0.055, 0.045, -0.015, 0.005), 1e-12);
-  EXPECT_EQ(r.estimated_points, static_cast<std::size_t>(std::llround(0.1 * 0.02 / 25e-6)));
+  EXPECT_EQ(r.estimated_points,
+            static_cast<std::size_t>(std::llround(0.1 * 0.02 / 25e-6)));
   // The points in the window: columns 0..9 of the rows -1 and 0.
   EXPECT_EQ(r.num_points, 20u);
   EXPECT_NEAR(r.box_min.z(), 1.0f, 1e-6f);
@@ -319,7 +333,8 @@ TEST_F(CubeRegions, WindowsCoverTheGroundTruthEdges)
   for (const auto& r : regions)
     solid_angle += r.solid_angle;
   const auto s = sim::makeCubeScene().sensor;
-  EXPECT_LT(solid_angle, 0.45 * windowSolidAngle(s.theta_min, s.theta_max, s.phi_min, s.phi_max));
+  EXPECT_LT(solid_angle,
+            0.45 * windowSolidAngle(s.theta_min, s.theta_max, s.phi_min, s.phi_max));
   // Sorted by priority.
   for (std::size_t i = 1; i < regions.size(); ++i)
     EXPECT_GE(regions[i - 1].priority, regions[i].priority);
@@ -369,18 +384,22 @@ TEST_F(CubeRegions, NoMergeableOverlapRemains)
     for (std::size_t j = i + 1; j < regions.size(); ++j) {
       const auto& a = regions[i];
       const auto& b = regions[j];
-      const double w = std::min(a.theta_max, b.theta_max) - std::max(a.theta_min, b.theta_min);
+      const double w =
+          std::min(a.theta_max, b.theta_max) - std::max(a.theta_min, b.theta_min);
       const double h = std::min(a.phi_max, b.phi_max) - std::max(a.phi_min, b.phi_min);
       if (w <= 0.0 || h <= 0.0)
         continue;
-      const double uw = std::max(a.theta_max, b.theta_max) - std::min(a.theta_min, b.theta_min);
+      const double uw =
+          std::max(a.theta_max, b.theta_max) - std::min(a.theta_min, b.theta_min);
       const double uh = std::max(a.phi_max, b.phi_max) - std::min(a.phi_min, b.phi_min);
       const double area_a = (a.theta_max - a.theta_min) * (a.phi_max - a.phi_min);
       const double area_b = (b.theta_max - b.theta_min) * (b.phi_max - b.phi_min);
-      const bool fits = uw <= std::max({p.max_window_size, a.theta_max - a.theta_min,
-                                        b.theta_max - b.theta_min}) &&
-                        uh <= std::max({p.max_window_size, a.phi_max - a.phi_min,
-                                        b.phi_max - b.phi_min});
+      const bool fits =
+          uw <= std::max({p.max_window_size,
+                          a.theta_max - a.theta_min,
+                          b.theta_max - b.theta_min}) &&
+          uh <= std::max(
+                    {p.max_window_size, a.phi_max - a.phi_min, b.phi_max - b.phi_min});
       EXPECT_FALSE(fits && uw * uh <= p.merge_area_ratio * (area_a + area_b - w * h))
           << "windows " << i << " and " << j << " should have merged";
     }
@@ -413,7 +432,8 @@ TEST_F(CubeRegions, SensorFrameWithARotatedSensor)
     const auto same = std::find_if(b.begin(), b.end(), [&](const auto& s) {
       return std::abs(s.theta_min - r.theta_min) < 1e-4 &&
              std::abs(s.theta_max - r.theta_max) < 1e-4 &&
-             std::abs(s.phi_min - r.phi_min) < 1e-4 && std::abs(s.phi_max - r.phi_max) < 1e-4;
+             std::abs(s.phi_min - r.phi_min) < 1e-4 &&
+             std::abs(s.phi_max - r.phi_max) < 1e-4;
     });
     if (same == b.end())
       continue;

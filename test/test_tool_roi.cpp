@@ -18,8 +18,9 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
-#include <sys/wait.h>
 #include <vector>
+
+#include <sys/wait.h>
 
 namespace fs = std::filesystem;
 namespace sim = pcl::selective_seg::simulation;
@@ -61,9 +62,10 @@ protected:
   {
     if (tool.empty() || !fs::exists(tool))
       GTEST_SKIP() << "tool missing";
-    dir = fs::temp_directory_path() /
-          ("selseg_tool_roi_" +
-           std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    dir =
+        fs::temp_directory_path() /
+        ("selseg_tool_roi_" +
+         std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
     fs::remove_all(dir);
     fs::create_directories(dir);
     // The cube scene, coarse (about 2,500 points), sensor at the origin.
@@ -129,9 +131,10 @@ TEST_F(ToolRegions, WindowsFollowTheSensorNotTheCloudFrame)
   moved.sensor_origin_ = Eigen::Vector4f(0.5f, 1.0f, -2.0f, 0.0f);
   moved.sensor_orientation_ = Eigen::Quaternionf(pose.linear());
   ASSERT_EQ(pcl::io::savePCDFileBinary(out("moved.pcd"), moved), 0);
-  ASSERT_EQ(run(out("cube.pcd") + " -roi_json " + out("a.json") + " -roi_max_regions 5"), 0);
-  ASSERT_EQ(run(out("moved.pcd") + " -roi_json " + out("b.json") + " -roi_max_regions 5"),
-            0);
+  ASSERT_EQ(
+      run(out("cube.pcd") + " -roi_json " + out("a.json") + " -roi_max_regions 5"), 0);
+  ASSERT_EQ(
+      run(out("moved.pcd") + " -roi_json " + out("b.json") + " -roi_max_regions 5"), 0);
   const auto a = numbers(slurp(out("a.json")), "phi_min");
   const auto b = numbers(slurp(out("b.json")), "phi_min");
   ASSERT_EQ(a.size(), 5u);
@@ -145,8 +148,8 @@ TEST_F(ToolRegions, BadBudgetIsAUsageErrorWithNoOutput)
   EXPECT_EQ(run(out("cube.pcd") + " -o " + out("labels.pcd") + " -roi_json " +
                 out("rois.json") + " -roi_max_window_deg 0"),
             2);
-  EXPECT_EQ(run(out("cube.pcd") + " -roi_json " + out("rois.json") + " -roi_weights 1,2"),
-            2);
+  EXPECT_EQ(
+      run(out("cube.pcd") + " -roi_json " + out("rois.json") + " -roi_weights 1,2"), 2);
   EXPECT_FALSE(fs::exists(out("labels.pcd")));
   EXPECT_FALSE(fs::exists(out("rois.json")));
 }

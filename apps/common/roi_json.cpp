@@ -93,7 +93,8 @@ writeRegionsJson(const std::string& path,
       << "  \"counts\": {\"transition_vertices\": " << s.transition_vertices
       << ", \"small_segment_vertices\": " << s.small_segment_vertices
       << ", \"sparse_vertices\": " << s.sparse_vertices
-      << ", \"candidates\": " << s.candidates << ", \"already_fine\": " << s.already_fine
+      << ", \"candidates\": " << s.candidates
+      << ", \"already_fine\": " << s.already_fine
       << ", \"over_budget\": " << s.over_budget << ", \"selected\": " << s.selected
       << ", \"selected_solid_angle_sr\": " << s.selected_solid_angle
       << ", \"selected_points\": " << s.selected_points << "},\n  \"regions\": [";
@@ -105,9 +106,10 @@ writeRegionsJson(const std::string& path,
     putVector(out, r.box_min);
     out << ", \"box_max\": ";
     putVector(out, r.box_max);
-    out << ", \"priority\": " << r.priority << ", \"suggested_step\": "
-        << r.suggested_step << ", \"current_step\": " << r.current_step
-        << ", \"reasons\": \"" << pcl::selective_seg::reasonsToString(r.reasons)
+    out << ", \"priority\": " << r.priority
+        << ", \"suggested_step\": " << r.suggested_step
+        << ", \"current_step\": " << r.current_step << ", \"reasons\": \""
+        << pcl::selective_seg::reasonsToString(r.reasons)
         << "\", \"evidence\": " << r.num_evidence << ", \"points\": " << r.num_points
         << ", \"estimated_points\": " << r.estimated_points
         << ", \"solid_angle_sr\": " << r.solid_angle << "}";

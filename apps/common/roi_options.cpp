@@ -6,12 +6,12 @@
 
 #include "roi_options.h"
 
-#include "segmentation_options.h"
-
 #include <pcl/console/parse.h>
 #include <pcl/console/print.h>
 
 #include <cmath>
+
+#include "segmentation_options.h"
 
 namespace selseg_apps {
 
@@ -139,7 +139,8 @@ parseRegionOptions(int argc,
     std::vector<double> w;
     if (pcl::console::parse_x_arguments(argc, argv, "-roi_weights", w) < 0 ||
         w.size() != 5) {
-      pcl::console::print_error("Option -roi_weights needs 5 comma-separated numbers.\n");
+      pcl::console::print_error(
+          "Option -roi_weights needs 5 comma-separated numbers.\n");
       return false;
     }
     p.transition_weight = w[0];

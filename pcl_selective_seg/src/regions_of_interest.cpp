@@ -45,7 +45,11 @@ finiteAtLeast(double value, double lo)
 /** Union-find over vertices, with path halving; the root is the smallest member. */
 class DisjointSets {
 public:
-  explicit DisjointSets(std::size_t n) : parent_(n) { std::iota(parent_.begin(), parent_.end(), 0); }
+  explicit DisjointSets(std::size_t n)
+      : parent_(n)
+  {
+    std::iota(parent_.begin(), parent_.end(), 0);
+  }
   std::size_t find(std::size_t x)
   {
     while (parent_[x] != x) {
@@ -79,7 +83,8 @@ struct Window {
 double
 overlapArea(const Window& a, const Window& b)
 {
-  const double w = std::min(a.theta_max, b.theta_max) - std::max(a.theta_min, b.theta_min);
+  const double w =
+      std::min(a.theta_max, b.theta_max) - std::max(a.theta_min, b.theta_min);
   const double h = std::min(a.phi_max, b.phi_max) - std::max(a.phi_min, b.phi_min);
   return w > 0.0 && h > 0.0 ? w * h : 0.0;
 }
@@ -88,7 +93,8 @@ overlapArea(const Window& a, const Window& b)
 bool
 meet(const Window& a, const Window& b)
 {
-  const double w = std::min(a.theta_max, b.theta_max) - std::max(a.theta_min, b.theta_min);
+  const double w =
+      std::min(a.theta_max, b.theta_max) - std::max(a.theta_min, b.theta_min);
   const double h = std::min(a.phi_max, b.phi_max) - std::max(a.phi_min, b.phi_min);
   return w >= 0.0 && h >= 0.0 && (w > 0.0 || h > 0.0);
 }
@@ -116,7 +122,8 @@ median(std::vector<double> v)
 
 /** Median angular length of the mesh edges at each vertex [rad] (0 when isolated). */
 std::vector<double>
-vertexSpacing(const SphericalTriangulation& tri, const std::vector<Eigen::Vector2d>& angles)
+vertexSpacing(const SphericalTriangulation& tri,
+              const std::vector<Eigen::Vector2d>& angles)
 {
   const std::size_t nv = angles.size();
   std::vector<std::size_t> start(nv + 1, 0);
@@ -194,9 +201,10 @@ markLeafEvidence(const SegmentationResult& result,
     return;
   std::sort(cells.begin(), cells.end());
   for (std::size_t v = 0; v < tri.vertex_positions.size(); ++v)
-    if (std::binary_search(cells.begin(),
-                           cells.end(),
-                           cellKey(tri.vertex_positions[v].cast<double>(), origin, size)))
+    if (std::binary_search(
+            cells.begin(),
+            cells.end(),
+            cellKey(tri.vertex_positions[v].cast<double>(), origin, size)))
       kinds[v] |= kTransition;
 }
 
@@ -372,8 +380,9 @@ mergeWindows(std::vector<Window>& windows, const RegionOfInterestParameters& p)
         const Window& b = windows[j];
         const double common = overlapArea(a, b);
         Window u = boundingWindow(a, b);
-        const bool fits = u.width() <= std::max({p.max_window_size, a.width(), b.width()}) &&
-                          u.height() <= std::max({p.max_window_size, a.height(), b.height()});
+        const bool fits =
+            u.width() <= std::max({p.max_window_size, a.width(), b.width()}) &&
+            u.height() <= std::max({p.max_window_size, a.height(), b.height()});
         if (meet(a, b) && fits &&
             u.area() <= p.merge_area_ratio * (a.area() + b.area() - common)) {
           u.reasons = a.reasons | b.reasons;
@@ -383,15 +392,16 @@ mergeWindows(std::vector<Window>& windows, const RegionOfInterestParameters& p)
           windows.erase(windows.begin() + static_cast<std::ptrdiff_t>(j));
           changed = true;
           j = i + 1; // a grew: look at every other window again
-        }
-        else
+        } else
           ++j;
       }
   }
 }
 
 double
-kindWeight(std::uint8_t kinds, double transition_strength, const RegionOfInterestParameters& p)
+kindWeight(std::uint8_t kinds,
+           double transition_strength,
+           const RegionOfInterestParameters& p)
 {
   double w = 0.0;
   if (kinds & kTransition)
@@ -431,7 +441,8 @@ RegionOfInterestParameters::validate(std::string* why) const
   if (!(max_window_size > 0.0 && max_window_size <= M_PI))
     return reject(why, "max_window_size", max_window_size, "(0, pi] [rad]");
   if (!(min_window_size >= 0.0 && min_window_size <= max_window_size))
-    return reject(why, "min_window_size", min_window_size, "[0, max_window_size] [rad]");
+    return reject(
+        why, "min_window_size", min_window_size, "[0, max_window_size] [rad]");
   if (!finiteAtLeast(margin, 0.0))
     return reject(why, "margin", margin, "[0, inf) [rad]");
   if (!finiteAtLeast(margin_spacings, 0.0))
@@ -455,7 +466,8 @@ RegionOfInterestParameters::validate(std::string* why) const
   if (!finiteAtLeast(sparse_weight, 0.0))
     return reject(why, "sparse_weight", sparse_weight, "[0, inf)");
   if (!finiteAtLeast(max_solid_angle, 0.0))
-    return reject(why, "max_solid_angle", max_solid_angle, "[0, inf) [sr], 0 = no limit");
+    return reject(
+        why, "max_solid_angle", max_solid_angle, "[0, inf) [sr], 0 = no limit");
   if (!(sample_yield > 0.0 && sample_yield <= 1.0))
     return reject(why, "sample_yield", sample_yield, "(0, 1]");
   return true;
@@ -569,11 +581,11 @@ computeRegionsOfInterest(const SegmentationResult& result,
         std::llround(p.sample_yield * area / (r.suggested_step * r.suggested_step)));
     // Vertices are numbered in increasing quantized theta: the window's are a range.
     const double q = tri.angle_quantization;
-    const auto first = std::lower_bound(
-        tri.vertex_angles.begin(),
-        tri.vertex_angles.end(),
-        r.theta_min / q,
-        [](const QuantizedPoint& a, double t) { return a[0] < t; });
+    const auto first =
+        std::lower_bound(tri.vertex_angles.begin(),
+                         tri.vertex_angles.end(),
+                         r.theta_min / q,
+                         [](const QuantizedPoint& a, double t) { return a[0] < t; });
     r.box_min = Eigen::Vector3f::Constant(std::numeric_limits<float>::max());
     r.box_max = Eigen::Vector3f::Constant(std::numeric_limits<float>::lowest());
     for (auto it = first; it != tri.vertex_angles.end() && (*it)[0] <= r.theta_max / q;
@@ -589,8 +601,8 @@ computeRegionsOfInterest(const SegmentationResult& result,
     }
     // The weighted share of the window's area its evidence stands for (each vertex
     // spacing^2), times the share of new samples a scan at the suggested step brings.
-    r.priority = weighted / std::max(area, covered) *
-                 (1.0 - r.suggested_step / r.current_step);
+    r.priority =
+        weighted / std::max(area, covered) * (1.0 - r.suggested_step / r.current_step);
     candidates.push_back(r);
   }
   std::sort(candidates.begin(), candidates.end(), [](const auto& a, const auto& b) {
@@ -598,11 +610,11 @@ computeRegionsOfInterest(const SegmentationResult& result,
            std::tie(a.priority, b.theta_min, b.phi_min, b.theta_max, b.phi_max);
   });
   for (const auto& r : candidates) {
-    const bool fits =
-        (p.max_regions == 0 || regions.size() < p.max_regions) &&
-        (p.max_points == 0 || st.selected_points + r.estimated_points <= p.max_points) &&
-        (p.max_solid_angle == 0.0 ||
-         st.selected_solid_angle + r.solid_angle <= p.max_solid_angle);
+    const bool fits = (p.max_regions == 0 || regions.size() < p.max_regions) &&
+                      (p.max_points == 0 ||
+                       st.selected_points + r.estimated_points <= p.max_points) &&
+                      (p.max_solid_angle == 0.0 ||
+                       st.selected_solid_angle + r.solid_angle <= p.max_solid_angle);
     if (!fits) {
       ++st.over_budget;
       continue;

@@ -582,8 +582,7 @@ boundaryDistances(const pcl::PointCloud<pcl::PointXYZ>& from,
       if (per_point)
         (*per_point)[i] = static_cast<float>(distances.back());
     }
-  }
-  else
+  } else
     for (const auto& p : from)
       if (pcl::isFinite(p))
         distances.push_back(kNaN);

@@ -78,7 +78,8 @@ makeReferenceBoundary(const SimulationSetup& setup,
   SensorSimulator simulator;
   auto cloud = pcl::make_shared<pcl::PointCloud<pcl::PointXYZL>>();
   if (!simulator.setParameters(sensor) ||
-      !simulator.simulateWindow(setup.scene, viewOf(sensor, step, kReferenceScan), *cloud))
+      !simulator.simulateWindow(
+          setup.scene, viewOf(sensor, step, kReferenceScan), *cloud))
     return false;
   SphericalDelaunay<pcl::PointXYZL> delaunay;
   delaunay.setInputCloud(cloud);
@@ -91,8 +92,12 @@ makeReferenceBoundary(const SimulationSetup& setup,
       triangles[t][k] = tri.vertex_point[tri.triangles[t][k]];
   pcl::Indices boundary;
   const auto xyz = toXYZ(*cloud);
-  if (!metrics::labelBoundaryPoints(
-          xyz, triangles, labelsOf(*cloud), Eigen::Vector3f::Zero(), 4.0 * step, boundary))
+  if (!metrics::labelBoundaryPoints(xyz,
+                                    triangles,
+                                    labelsOf(*cloud),
+                                    Eigen::Vector3f::Zero(),
+                                    4.0 * step,
+                                    boundary))
     return false;
   for (const auto i : boundary)
     reference.points.push_back(xyz[i]);
@@ -188,8 +193,10 @@ runSelectiveLoop(const SimulationSetup& setup,
   const double edge_angle = params.boundary_edge_steps * coarse_step;
   auto cloud = pcl::make_shared<pcl::PointCloud<pcl::PointXYZL>>();
   SimulationDetails details;
-  if (!simulator.simulateWindow(
-          setup.scene, viewOf(setup.sensor, coarse_step, kCoarseScan), *cloud, &details))
+  if (!simulator.simulateWindow(setup.scene,
+                                viewOf(setup.sensor, coarse_step, kCoarseScan),
+                                *cloud,
+                                &details))
     return fail("the coarse scan failed (reason above)");
   if (cloud->empty())
     return fail("the coarse scan has no point");
@@ -235,10 +242,10 @@ runSelectiveLoop(const SimulationSetup& setup,
         roi.max_window_size = std::min(M_PI, params.window_steps * coarse_step);
       roi.min_window_size = std::min(roi.min_window_size, roi.max_window_size);
       roi.sample_yield = yield;
-      roi.max_points =
-          std::max<std::size_t>(1,
-                                (params.point_budget - score.points) /
-                                    static_cast<std::size_t>(params.iterations - round));
+      roi.max_points = std::max<std::size_t>(
+          1,
+          (params.point_budget - score.points) /
+              static_cast<std::size_t>(params.iterations - round));
       pcl::StopWatch watch;
       Eigen::Affine3f pose = Eigen::Affine3f::Identity();
       if (!computeRegionsOfInterest(

@@ -77,9 +77,9 @@ struct PCL_EXPORTS RegionOfInterestParameters {
   /** \brief Margin added around the evidence in units of its current angular spacing
    * (the true edge lies anywhere between the coarse samples). Valid: >= 0, finite. */
   double margin_spacings = 1.0;
-  /** \brief Two overlapping (or edge-sharing) windows merge when their bounding window is at most this
-   * many times the area they cover together (and fits max_window_size): overlaps are
-   * removed where that wastes little. Valid: >= 1, finite. */
+  /** \brief Two overlapping (or edge-sharing) windows merge when their bounding window
+   * is at most this many times the area they cover together (and fits max_window_size):
+   * overlaps are removed where that wastes little. Valid: >= 1, finite. */
   double merge_area_ratio = 1.25;
 
   // --- sampling ---
@@ -140,13 +140,13 @@ struct RegionOfInterest {
    * suggested step brings, 1 - suggested_step / current_step; in [0, largest
    * weight]. */
   double priority = 0.0;
-  double suggested_step = 0.0; ///< angular step of the finer scan [rad]
-  double current_step = 0.0;   ///< median angular spacing of its evidence now [rad]
-  std::uint8_t reasons = 0;    ///< RegionReason bits
-  std::size_t num_evidence = 0;      ///< evidence vertices inside
-  std::size_t num_points = 0;        ///< mesh vertices of the scan inside the window
-  std::size_t estimated_points = 0;  ///< sample_yield x window area / step^2
-  double solid_angle = 0.0;          ///< of the window [sr]
+  double suggested_step = 0.0;  ///< angular step of the finer scan [rad]
+  double current_step = 0.0;    ///< median angular spacing of its evidence now [rad]
+  std::uint8_t reasons = 0;     ///< RegionReason bits
+  std::size_t num_evidence = 0; ///< evidence vertices inside
+  std::size_t num_points = 0;   ///< mesh vertices of the scan inside the window
+  std::size_t estimated_points = 0; ///< sample_yield x window area / step^2
+  double solid_angle = 0.0;         ///< of the window [sr]
 };
 
 /** \brief What computeRegionsOfInterest() found. */
@@ -164,10 +164,8 @@ struct RegionOfInterestStats {
 
 /** \brief Solid angle of an angular window of eq. 1's angles [sr] (exact: the window
  * is a rectangle on the plane z = 1). */
-PCL_EXPORTS double windowSolidAngle(double theta_min,
-                                    double theta_max,
-                                    double phi_min,
-                                    double phi_max);
+PCL_EXPORTS double
+windowSolidAngle(double theta_min, double theta_max, double phi_min, double phi_max);
 
 /** \brief Regions of interest of a segmentation for a finer acquisition.
  *
@@ -180,21 +178,19 @@ PCL_EXPORTS double windowSolidAngle(double theta_min,
  * depends on the segmentation only.
  *
  * \param[in] result the segmentation (labels, mesh classes, leaves)
- * \param[in] triangulation its triangulation (SelectiveSegmentation::getTriangulation())
- * \param[in] sensor_to_cloud the sensor pose used by the segmentation
- * \param[in] params the parameters
- * \param[out] regions the selected windows; empty on failure
- * \param[out] stats if non-null: counts of evidence and windows
- * \return false (with PCL_ERROR saying why) on invalid parameters or a result that
- *         does not belong to the triangulation. An empty scan gives no region.
+ * \param[in] triangulation its triangulation
+ * (SelectiveSegmentation::getTriangulation()) \param[in] sensor_to_cloud the sensor
+ * pose used by the segmentation \param[in] params the parameters \param[out] regions
+ * the selected windows; empty on failure \param[out] stats if non-null: counts of
+ * evidence and windows \return false (with PCL_ERROR saying why) on invalid parameters
+ * or a result that does not belong to the triangulation. An empty scan gives no region.
  */
-PCL_EXPORTS bool
-computeRegionsOfInterest(const SegmentationResult& result,
-                         const SphericalTriangulation& triangulation,
-                         const Eigen::Affine3f& sensor_to_cloud,
-                         const RegionOfInterestParameters& params,
-                         std::vector<RegionOfInterest>& regions,
-                         RegionOfInterestStats* stats = nullptr);
+PCL_EXPORTS bool computeRegionsOfInterest(const SegmentationResult& result,
+                                          const SphericalTriangulation& triangulation,
+                                          const Eigen::Affine3f& sensor_to_cloud,
+                                          const RegionOfInterestParameters& params,
+                                          std::vector<RegionOfInterest>& regions,
+                                          RegionOfInterestStats* stats = nullptr);
 
 /** \brief The same for a SelectiveSegmentation after a successful extract() or
  * update(), with the sensor pose of its input cloud (sensor_origin_ /

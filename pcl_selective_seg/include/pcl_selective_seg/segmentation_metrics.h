@@ -11,8 +11,8 @@
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 
-#include <cstddef>
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 

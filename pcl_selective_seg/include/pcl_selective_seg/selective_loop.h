@@ -54,8 +54,8 @@ struct PCL_EXPORTS ScanScore {
   /** Predicted boundary points to the nearest ground-truth boundary point (spurious
    * boundaries). */
   metrics::BoundaryDistances spurious;
-  metrics::HooverScores hoover;      ///< at T = 0.8
-  double under_segmentation = 0.0;   ///< metrics::underSegmentationError
+  metrics::HooverScores hoover;    ///< at T = 0.8
+  double under_segmentation = 0.0; ///< metrics::underSegmentationError
 };
 
 /** \brief Score a segmentation of a labeled scan: \a labels and \a triangles (over
@@ -99,7 +99,7 @@ struct PCL_EXPORTS SelectiveLoopParameters {
 
 /** \brief One round of the loop, as reported to the observer. */
 struct LoopRound {
-  int iteration = 0; ///< 0 = the coarse scan
+  int iteration = 0;                                      ///< 0 = the coarse scan
   const pcl::PointCloud<pcl::PointXYZL>* cloud = nullptr; ///< everything acquired
   const SegmentationResult* result = nullptr;             ///< its segmentation
   /** The windows chosen after this round and scanned for the next one (those of
@@ -117,11 +117,12 @@ struct LoopRound {
  * \param[out] rounds one score per round, the coarse scan first
  * \param[in] observer if set, called after every round (pictures, files)
  * \return false (with PCL_ERROR) on invalid parameters or a failed stage. */
-PCL_EXPORTS bool runSelectiveLoop(const SimulationSetup& setup,
-                                  const SelectiveLoopParameters& params,
-                                  const ReferenceBoundary& reference,
-                                  std::vector<ScanScore>& rounds,
-                                  const std::function<void(const LoopRound&)>& observer = {});
+PCL_EXPORTS bool
+runSelectiveLoop(const SimulationSetup& setup,
+                 const SelectiveLoopParameters& params,
+                 const ReferenceBoundary& reference,
+                 std::vector<ScanScore>& rounds,
+                 const std::function<void(const LoopRound&)>& observer = {});
 
 /** \brief A uniform scan of the whole view window at \a step, segmented and scored
  * (boundary edges up to 4 steps).
