@@ -366,35 +366,61 @@ windowLess(const Window& a, const Window& b)
          std::tie(b.theta_min, b.phi_min, b.theta_max, b.phi_max);
 }
 
-/** Merge overlapping windows while the bounding window wastes little area. */
+/** Whether b merges into a: they meet, their bounding window fits the tile size and
+ * wastes little area. */
+bool
+mergeable(const Window& a, const Window& b, const RegionOfInterestParameters& p)
+{
+  if (!meet(a, b))
+    return false;
+  const Window u = boundingWindow(a, b);
+  return u.width() <= std::max({p.max_window_size, a.width(), b.width()}) &&
+         u.height() <= std::max({p.max_window_size, a.height(), b.height()}) &&
+         u.area() <= p.merge_area_ratio * (a.area() + b.area() - overlapArea(a, b));
+}
+
+/** Merge overlapping windows while the bounding window wastes little area. A sweep in
+ * theta: window i is compared only with the later windows whose theta range starts
+ * inside its own; passes repeat until nothing merges. */
 void
 mergeWindows(std::vector<Window>& windows, const RegionOfInterestParameters& p)
 {
-  std::sort(windows.begin(), windows.end(), windowLess);
   bool changed = true;
   while (changed) {
     changed = false;
-    for (std::size_t i = 0; i < windows.size(); ++i)
-      for (std::size_t j = i + 1; j < windows.size();) {
-        Window& a = windows[i];
-        const Window& b = windows[j];
-        const double common = overlapArea(a, b);
-        Window u = boundingWindow(a, b);
-        const bool fits =
-            u.width() <= std::max({p.max_window_size, a.width(), b.width()}) &&
-            u.height() <= std::max({p.max_window_size, a.height(), b.height()});
-        if (meet(a, b) && fits &&
-            u.area() <= p.merge_area_ratio * (a.area() + b.area() - common)) {
+    std::sort(windows.begin(), windows.end(), windowLess);
+    std::vector<char> alive(windows.size(), 1);
+    for (std::size_t i = 0; i < windows.size(); ++i) {
+      if (!alive[i])
+        continue;
+      for (bool grew = true; grew;) {
+        grew = false;
+        for (std::size_t j = i + 1;
+             j < windows.size() && windows[j].theta_min <= windows[i].theta_max;
+             ++j) {
+          if (!alive[j] || !mergeable(windows[i], windows[j], p))
+            continue;
+          Window& a = windows[i];
+          Window& b = windows[j];
+          Window u = boundingWindow(a, b);
           u.reasons = a.reasons | b.reasons;
           u.evidence = std::move(a.evidence);
           u.evidence.insert(u.evidence.end(), b.evidence.begin(), b.evidence.end());
+          b.evidence.clear();
           a = std::move(u);
-          windows.erase(windows.begin() + static_cast<std::ptrdiff_t>(j));
-          changed = true;
-          j = i + 1; // a grew: look at every other window again
-        } else
-          ++j;
+          alive[j] = 0;
+          changed = grew = true;
+        }
       }
+    }
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < windows.size(); ++i)
+      if (alive[i]) {
+        if (kept != i)
+          windows[kept] = std::move(windows[i]);
+        ++kept;
+      }
+    windows.resize(kept);
   }
 }
 
