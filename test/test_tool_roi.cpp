@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "roi_json.h"
 #include <sys/wait.h>
 
 namespace fs = std::filesystem;
@@ -166,6 +167,51 @@ TEST_F(ToolRegions, UnwritableRegionsFileLeavesNoOutput)
     ++files;
   }
   EXPECT_EQ(files, 1u); // the input only
+}
+
+// What the viewer reads is what the tool wrote.
+TEST(RegionsJson, ReadsBackWhatWasWritten)
+{
+  const auto path =
+      (fs::temp_directory_path() / "selseg_regions_roundtrip.json").string();
+  std::vector<pcl::selective_seg::RegionOfInterest> written(2), read;
+  written[0].theta_min = -0.25;
+  written[0].theta_max = -0.125;
+  written[0].phi_min = 0.5;
+  written[0].phi_max = 0.75;
+  written[0].box_min = Eigen::Vector3f(-1.0f, 0.5f, 2.0f);
+  written[0].box_max = Eigen::Vector3f(1.0f, 1.5f, 3.0f);
+  written[0].priority = 0.5;
+  written[0].suggested_step = 0.002;
+  written[0].current_step = 0.006;
+  written[0].reasons = pcl::selective_seg::kTransition | pcl::selective_seg::kSparse;
+  written[1].theta_min = 0.0;
+  written[1].theta_max = 0.01;
+  written[1].phi_min = -0.01;
+  written[1].phi_max = 0.0;
+  written[1].reasons = pcl::selective_seg::kSmallSegment;
+  ASSERT_TRUE(
+      selseg_apps::writeRegionsJson(path, "in \"quotes\".pcd", {}, {}, written));
+  std::string error;
+  ASSERT_TRUE(selseg_apps::readRegionsJson(path, read, error)) << error;
+  ASSERT_EQ(read.size(), 2u);
+  for (std::size_t i = 0; i < 2; ++i) {
+    EXPECT_EQ(read[i].theta_min, written[i].theta_min);
+    EXPECT_EQ(read[i].theta_max, written[i].theta_max);
+    EXPECT_EQ(read[i].phi_min, written[i].phi_min);
+    EXPECT_EQ(read[i].phi_max, written[i].phi_max);
+    EXPECT_EQ(read[i].reasons, written[i].reasons);
+    EXPECT_EQ(read[i].box_max, written[i].box_max);
+  }
+  EXPECT_EQ(read[0].suggested_step, 0.002);
+  // A window with theta_min >= theta_max is an error naming the file and the region.
+  std::ofstream(path) << "{\"regions\": [{\"theta_min\": 1, \"theta_max\": 0, "
+                         "\"phi_min\": 0, \"phi_max\": 1}]}";
+  EXPECT_FALSE(selseg_apps::readRegionsJson(path, read, error));
+  EXPECT_NE(error.find("region 1"), std::string::npos) << error;
+  EXPECT_TRUE(read.empty());
+  fs::remove(path);
+  EXPECT_FALSE(selseg_apps::readRegionsJson(path, read, error));
 }
 
 int
