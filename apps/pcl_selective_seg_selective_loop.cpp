@@ -53,6 +53,7 @@ struct Options {
   double step_scale = 1.0;
   double window_steps = 2.0;
   pcl::selective_seg::RegionOfInterestParameters regions;
+  pcl::selective_seg::SelectiveSegmentationParameters segmentation;
 };
 
 /** Finest step of each scene [rad]: about four times the paper's point count. */
@@ -93,6 +94,8 @@ printHelp(const char* program)
       "is 0.5 here):\n",
       program);
   selseg_apps::printRegionHelp();
+  print_info("Segmentation (both strategies):\n");
+  selseg_apps::printSegmentationHelp();
 }
 
 bool
@@ -104,6 +107,9 @@ parseOptions(int argc, char** argv, Options& opt)
                        a == "-coarse_factor" || a == "-budget_fraction" ||
                        a == "-range_noise" || a == "-min_voxel_factor" ||
                        a == "-step_scale" || a == "-window_steps" ||
+                       std::find(selseg_apps::segmentationFlags().begin(),
+                                 selseg_apps::segmentationFlags().end(),
+                                 a) != selseg_apps::segmentationFlags().end() ||
                        std::find(selseg_apps::regionFlags().begin(),
                                  selseg_apps::regionFlags().end(),
                                  a) != selseg_apps::regionFlags().end();
@@ -142,8 +148,14 @@ parseOptions(int argc, char** argv, Options& opt)
       !parseNumber(argc, argv, "-min_voxel_factor", opt.min_voxel_factor) ||
       !parseNumber(argc, argv, "-step_scale", opt.step_scale) ||
       !parseNumber(argc, argv, "-window_steps", opt.window_steps) ||
-      !selseg_apps::parseRegionOptions(argc, argv, opt.regions))
+      !selseg_apps::parseRegionOptions(argc, argv, opt.regions) ||
+      !selseg_apps::parseSegmentationOptions(argc, argv, opt.segmentation))
     return false;
+  if (opt.segmentation.min_voxel_size > 0.0) {
+    print_error("-min_voxel_m does not apply here: the loop sets the voxel with "
+                "-min_voxel_factor, the uniform scans choose theirs.\n");
+    return false;
+  }
   if (opt.iterations < 0 || opt.iterations > 100 || !(opt.coarse_factor >= 1.0) ||
       !(opt.budget_fraction > 0.0 && opt.budget_fraction <= 1.0) ||
       !(opt.range_noise >= 0.0 && opt.range_noise <= 1.0) ||
@@ -233,7 +245,8 @@ runScene(const Options& opt, const std::string& name, std::string& table)
              reference.scan_points,
              reference.points.size());
 
-  const pcl::selective_seg::SelectiveSegmentationParameters seg_params;
+  const pcl::selective_seg::SelectiveSegmentationParameters& seg_params =
+      opt.segmentation;
   std::vector<sim::ScanScore> uniform;
   const std::vector<double> factors = {3.0, 2.5, 2.0, 1.6, 1.3, 1.0};
   for (const double f : factors) {
@@ -255,6 +268,7 @@ runScene(const Options& opt, const std::string& name, std::string& table)
   loop.iterations = opt.iterations;
   loop.min_voxel_factor = opt.min_voxel_factor;
   loop.regions = opt.regions;
+  loop.segmentation = opt.segmentation;
   loop.window_steps = opt.window_steps;
   loop.point_budget =
       static_cast<std::size_t>(opt.budget_fraction * static_cast<double>(dense_points));
