@@ -52,6 +52,7 @@ struct Options {
   double min_voxel_factor = 2.0;
   double step_scale = 1.0;
   double window_steps = 2.0;
+  double progressive = 1.0;
   pcl::selective_seg::RegionOfInterestParameters regions;
   pcl::selective_seg::SelectiveSegmentationParameters segmentation;
 };
@@ -85,6 +86,8 @@ printHelp(const char* program)
       "level A)\n"
       "  -min_voxel_factor X    finest voxel = X fine steps at the median range; 0 = "
       "automatic from the coarse scan (default 2)\n"
+      "  -progressive 0|1       1: each round a step finer, the last at the fine "
+      "step; 0: every round at the fine step (default 1)\n"
       "  -window_steps X        evidence tiles of X coarse steps; 0 = "
       "-roi_max_window_deg (default 2)\n"
       "  -step_scale S          multiply every step by S (S > 1: a quicker, coarser "
@@ -103,16 +106,16 @@ parseOptions(int argc, char** argv, Options& opt)
 {
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    const bool known = a == "-out" || a == "-scenes" || a == "-iterations" ||
-                       a == "-coarse_factor" || a == "-budget_fraction" ||
-                       a == "-range_noise" || a == "-min_voxel_factor" ||
-                       a == "-step_scale" || a == "-window_steps" ||
-                       std::find(selseg_apps::segmentationFlags().begin(),
-                                 selseg_apps::segmentationFlags().end(),
-                                 a) != selseg_apps::segmentationFlags().end() ||
-                       std::find(selseg_apps::regionFlags().begin(),
-                                 selseg_apps::regionFlags().end(),
-                                 a) != selseg_apps::regionFlags().end();
+    const bool known =
+        a == "-out" || a == "-scenes" || a == "-iterations" || a == "-coarse_factor" ||
+        a == "-budget_fraction" || a == "-range_noise" || a == "-min_voxel_factor" ||
+        a == "-step_scale" || a == "-window_steps" || a == "-progressive" ||
+        std::find(selseg_apps::segmentationFlags().begin(),
+                  selseg_apps::segmentationFlags().end(),
+                  a) != selseg_apps::segmentationFlags().end() ||
+        std::find(selseg_apps::regionFlags().begin(),
+                  selseg_apps::regionFlags().end(),
+                  a) != selseg_apps::regionFlags().end();
     if (!known || i + 1 >= argc) {
       print_error("%s '%s' (see -h).\n",
                   known ? "Missing value of" : "Unknown argument",
@@ -148,6 +151,7 @@ parseOptions(int argc, char** argv, Options& opt)
       !parseNumber(argc, argv, "-min_voxel_factor", opt.min_voxel_factor) ||
       !parseNumber(argc, argv, "-step_scale", opt.step_scale) ||
       !parseNumber(argc, argv, "-window_steps", opt.window_steps) ||
+      !parseNumber(argc, argv, "-progressive", opt.progressive) ||
       !selseg_apps::parseRegionOptions(argc, argv, opt.regions) ||
       !selseg_apps::parseSegmentationOptions(argc, argv, opt.segmentation))
     return false;
@@ -160,10 +164,11 @@ parseOptions(int argc, char** argv, Options& opt)
       !(opt.budget_fraction > 0.0 && opt.budget_fraction <= 1.0) ||
       !(opt.range_noise >= 0.0 && opt.range_noise <= 1.0) ||
       !(opt.min_voxel_factor >= 0.0) || !(opt.step_scale > 0.0) ||
-      !(opt.window_steps >= 0.0)) {
+      !(opt.window_steps >= 0.0) ||
+      (opt.progressive != 0.0 && opt.progressive != 1.0)) {
     print_error("Need 0 <= iterations <= 100, coarse_factor >= 1, 0 < budget_fraction "
                 "<= 1, 0 <= range_noise <= 1, min_voxel_factor >= 0, step_scale > 0, "
-                "window_steps >= 0.\n");
+                "window_steps >= 0, progressive 0 or 1.\n");
     return false;
   }
   return true;
@@ -270,6 +275,7 @@ runScene(const Options& opt, const std::string& name, std::string& table)
   loop.regions = opt.regions;
   loop.segmentation = opt.segmentation;
   loop.window_steps = opt.window_steps;
+  loop.progressive = opt.progressive == 1.0;
   loop.point_budget =
       static_cast<std::size_t>(opt.budget_fraction * static_cast<double>(dense_points));
   std::vector<RegionOfInterest> scanned;

@@ -237,7 +237,13 @@ runSelectiveLoop(const SimulationSetup& setup,
     stats = RegionOfInterestStats();
     if (round < params.iterations && score.points < params.point_budget) {
       RegionOfInterestParameters roi = params.regions;
-      roi.target_step = params.fine_step;
+      // Progressive: round r + 1 of n refines to coarse x (fine / coarse)^((r + 1) /
+      // n).
+      roi.target_step =
+          params.progressive
+              ? coarse_step * std::pow(params.fine_step / coarse_step,
+                                       double(round + 1) / double(params.iterations))
+              : params.fine_step;
       if (params.window_steps > 0.0)
         roi.max_window_size = std::min(M_PI, params.window_steps * coarse_step);
       roi.min_window_size = std::min(roi.min_window_size, roi.max_window_size);

@@ -70,13 +70,17 @@ PCL_EXPORTS bool scoreSegmentation(const pcl::PointCloud<pcl::PointXYZL>& cloud,
 
 /** \brief Parameters of the simulated coarse-to-fine loop. */
 struct PCL_EXPORTS SelectiveLoopParameters {
-  /** \brief Angular step of the finest scans: the target step of the regions of
-   * interest [rad], > 0. */
+  /** \brief Angular step of the finest scans: the target step of the last round's
+   * regions of interest [rad], > 0. */
   double fine_step = 0.004;
   /** \brief The coarse scan's step is this many times fine_step, >= 1. */
   double coarse_factor = 3.0;
   /** \brief Refinement rounds (ROI, scan, update), >= 0. */
   int iterations = 3;
+  /** \brief Each round a step finer: round r of n targets coarse_step x (fine_step /
+   * coarse_step)^(r / n), the last fine_step (a round confirms and narrows the
+   * transitions the previous one found). false: every round targets fine_step. */
+  bool progressive = true;
   /** \brief Points the whole loop may acquire, the coarse scan included, > 0; each
    * round may use the remaining budget divided by the remaining rounds. */
   std::size_t point_budget = 10000;
