@@ -198,6 +198,20 @@ TEST(RegionsOfInterest, EmptyAndMismatchedInput)
                                         Eigen::Affine3f::Identity(),
                                         RegionOfInterestParameters(),
                                         regions));
+  g = makeGrid(10, 6, 0.01, 2);
+  g.tri.triangles[3][1] = 60; // 60 vertices
+  EXPECT_FALSE(computeRegionsOfInterest(g.result,
+                                        g.tri,
+                                        Eigen::Affine3f::Identity(),
+                                        RegionOfInterestParameters(),
+                                        regions));
+  g = makeGrid(10, 6, 0.01, 2);
+  g.tri.neighbours[0][0] = -2;
+  EXPECT_FALSE(computeRegionsOfInterest(g.result,
+                                        g.tri,
+                                        Eigen::Affine3f::Identity(),
+                                        RegionOfInterestParameters(),
+                                        regions));
   // A segmentation without any evidence proposes nothing.
   g = makeGrid(10, 6, 0.01, -1);
   RegionOfInterestParameters p;

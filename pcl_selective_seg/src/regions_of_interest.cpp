@@ -553,6 +553,18 @@ computeRegionsOfInterest(const SegmentationResult& result,
                 v);
       return false;
     }
+  const auto nt = static_cast<pcl::index_t>(tri.triangles.size());
+  for (std::size_t t = 0; t < tri.triangles.size(); ++t)
+    for (int k = 0; k < 3; ++k)
+      if (tri.triangles[t][k] < 0 ||
+          static_cast<std::size_t>(tri.triangles[t][k]) >= nv ||
+          tri.neighbours[t][k] < -1 || tri.neighbours[t][k] >= nt) {
+        PCL_ERROR(
+            "[pcl::selective_seg::computeRegionsOfInterest] triangle %zu refers to "
+            "a vertex or neighbour out of range\n",
+            t);
+        return false;
+      }
   if (nv == 0)
     return true;
   std::vector<Eigen::Vector2d> angles(nv);
