@@ -22,6 +22,7 @@
 
 #include "roi_json.h"
 #include <sys/wait.h>
+#include <unistd.h>
 
 namespace fs = std::filesystem;
 namespace sim = pcl::selective_seg::simulation;
