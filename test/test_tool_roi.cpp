@@ -64,9 +64,10 @@ protected:
   {
     if (tool.empty() || !fs::exists(tool))
       GTEST_SKIP() << "tool missing";
+    // The process id keeps concurrent runs (other build trees) apart.
     dir =
         fs::temp_directory_path() /
-        ("selseg_tool_roi_" +
+        ("selseg_tool_roi_" + std::to_string(::getpid()) + "_" +
          std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
     fs::remove_all(dir);
     fs::create_directories(dir);
@@ -173,8 +174,9 @@ TEST_F(ToolRegions, UnwritableRegionsFileLeavesNoOutput)
 // What the viewer reads is what the tool wrote.
 TEST(RegionsJson, ReadsBackWhatWasWritten)
 {
-  const auto path =
-      (fs::temp_directory_path() / "selseg_regions_roundtrip.json").string();
+  const auto path = (fs::temp_directory_path() / ("selseg_regions_roundtrip_" +
+                                                  std::to_string(::getpid()) + ".json"))
+                        .string();
   std::vector<pcl::selective_seg::RegionOfInterest> written(2), read;
   written[0].theta_min = -0.25;
   written[0].theta_max = -0.125;
