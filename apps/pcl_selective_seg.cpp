@@ -12,6 +12,7 @@
 // unwritable output), 2 = usage error (unknown option, bad value). Outputs are written
 // under temporary names and renamed only when all succeeded.
 
+#include <pcl_selective_seg/regions_of_interest.h>
 #include <pcl_selective_seg/selective_segmentation.h>
 
 #include <pcl/console/parse.h>
@@ -26,6 +27,8 @@
 #include <vector>
 
 #include "outputs.h"
+#include "roi_json.h"
+#include "roi_options.h"
 #include "scan_io.h"
 #include "segmentation_options.h"
 
@@ -40,8 +43,9 @@ constexpr int kUsageError = 2;
 struct Options {
   std::string input;
   double unit_scale = 1.0;
-  std::string labels, mesh_ply, mesh_vtk, leaves, json;
+  std::string labels, mesh_ply, mesh_vtk, leaves, json, roi_json;
   SelectiveSegmentationParameters params;
+  pcl::selective_seg::RegionOfInterestParameters roi;
   bool ignore_viewpoint = false;
   std::vector<double> sensor_origin;      ///< x y z [m], empty = from the file
   std::vector<double> sensor_orientation; ///< qw qx qy qz, empty = from the file
@@ -53,6 +57,7 @@ const std::vector<std::string> kValueFlags = {"-o",
                                               "-mesh_vtk",
                                               "-leaves",
                                               "-json",
+                                              "-roi_json",
                                               "-unit_scale",
                                               "-sensor_origin",
                                               "-sensor_orientation"};
@@ -77,7 +82,11 @@ printHelp(const char* program)
              "  -leaves FILE.pcd         octree leaves: centre, size, depth, label, "
              "normal, sigma_theta, sigma_phi\n"
              "  -json FILE.json          summary: counts, timings, segment sizes and "
-             "normals\n\n");
+             "normals\n"
+             "  -roi_json FILE.json      regions of interest for a finer scan: angular "
+             "windows (sensor frame),\n"
+             "                           3-D boxes (cloud frame), priorities, steps; "
+             "budget flags below\n\n");
   print_info("Input and sensor:\n"
              "  -unit_scale X            multiply coordinates by X, e.g. 0.01 for "
              "centimetres (default 1)\n"
@@ -88,6 +97,7 @@ printHelp(const char* program)
              "  -ignore_viewpoint        sensor at the origin looking along +z, "
              "whatever the file says\n\n");
   selseg_apps::printSegmentationHelp();
+  selseg_apps::printRegionHelp();
   print_info("  -h, --help             this help\n");
 }
 
@@ -99,7 +109,7 @@ optionKind(const std::string& arg)
   const auto in = [&](const std::vector<std::string>& v) {
     return std::find(v.begin(), v.end(), arg) != v.end();
   };
-  if (in(kValueFlags) || in(seg))
+  if (in(kValueFlags) || in(seg) || in(selseg_apps::regionFlags()))
     return 1;
   return in(kSwitches) ? 0 : -1;
 }
@@ -161,6 +171,7 @@ parseOptions(int argc, char** argv, Options& opt)
   parse_argument(argc, argv, "-mesh_vtk", opt.mesh_vtk);
   parse_argument(argc, argv, "-leaves", opt.leaves);
   parse_argument(argc, argv, "-json", opt.json);
+  parse_argument(argc, argv, "-roi_json", opt.roi_json);
   opt.ignore_viewpoint = find_switch(argc, argv, "-ignore_viewpoint");
   if (!selseg_apps::parseNumber(argc, argv, "-unit_scale", opt.unit_scale) ||
       !(opt.unit_scale > 0.0) ||
@@ -170,8 +181,10 @@ parseOptions(int argc, char** argv, Options& opt)
       print_error("Option -unit_scale needs a positive number.\n");
     return kUsageError;
   }
-  return selseg_apps::parseSegmentationOptions(argc, argv, opt.params) ? 0
-                                                                       : kUsageError;
+  return selseg_apps::parseSegmentationOptions(argc, argv, opt.params) &&
+                 selseg_apps::parseRegionOptions(argc, argv, opt.roi)
+             ? 0
+             : kUsageError;
 }
 
 /** The sensor pose from the options, or false to keep the file's. */
@@ -247,7 +260,8 @@ printSummary(const pcl::selective_seg::SegmentationResult& r)
 bool
 writeOutputs(const Options& opt,
              const pcl::PointCloud<pcl::PointXYZ>& cloud,
-             const pcl::selective_seg::SelectiveSegmentation<pcl::PointXYZ>& seg)
+             const pcl::selective_seg::SelectiveSegmentation<pcl::PointXYZ>& seg,
+             const Eigen::Affine3f& pose)
 {
   using namespace selseg_apps;
   const auto& r = seg.getResult();
@@ -265,6 +279,23 @@ writeOutputs(const Options& opt,
     return false;
   };
   std::string error;
+  std::vector<pcl::selective_seg::RegionOfInterest> regions;
+  pcl::selective_seg::RegionOfInterestStats stats;
+  if (!opt.roi_json.empty()) {
+    if (!pcl::selective_seg::computeRegionsOfInterest(
+            r, seg.getTriangulation(), pose, opt.roi, regions, &stats)) {
+      print_error("Computing the regions of interest failed (reason above).\n");
+      return false;
+    }
+    print_info("Regions of interest: %zu chosen (%.4f sr, %zu points estimated) of %zu "
+               "candidates; %zu already fine, %zu over the budget\n",
+               stats.selected,
+               stats.selected_solid_angle,
+               stats.selected_points,
+               stats.candidates,
+               stats.already_fine,
+               stats.over_budget);
+  }
   const bool ok =
       write(opt.labels,
             [&](const std::string& f) {
@@ -277,7 +308,10 @@ writeOutputs(const Options& opt,
       write(opt.leaves,
             [&](const std::string& f) { return writeLeaves(f, r.leaves); }) &&
       write(opt.json,
-            [&](const std::string& f) { return writeSummaryJson(f, info, r); });
+            [&](const std::string& f) { return writeSummaryJson(f, info, r); }) &&
+      write(opt.roi_json, [&](const std::string& f) {
+        return writeRegionsJson(f, opt.input, opt.roi, stats, regions);
+      });
   if (ok && !outputs.commit(error)) {
     print_error("%s\n", error.c_str());
     return false;
@@ -305,9 +339,13 @@ segment(const Options& opt)
 
   pcl::selective_seg::SelectiveSegmentation<pcl::PointXYZ> seg;
   seg.setParameters(opt.params);
-  Eigen::Affine3f pose;
+  Eigen::Affine3f pose = Eigen::Affine3f::Identity();
   if (sensorPose(opt, *cloud, pose))
     seg.setSensorPose(pose);
+  else {
+    pose.translation() = cloud->sensor_origin_.head<3>();
+    pose.linear() = cloud->sensor_orientation_.normalized().toRotationMatrix();
+  }
   seg.setInputCloud(cloud);
   std::vector<pcl::PointIndices> segments;
   if (!seg.extract(segments)) {
@@ -321,7 +359,7 @@ segment(const Options& opt)
   printTimings(seg.getResult());
   printSummary(seg.getResult());
   timer.tic();
-  if (!writeOutputs(opt, *cloud, seg))
+  if (!writeOutputs(opt, *cloud, seg, pose))
     return kRuntimeError;
   print_info("Outputs written [done, %g ms]\n", timer.toc());
   return 0;

@@ -13,6 +13,7 @@
 // Exit codes: 0 = success, 1 = runtime error (unreadable input, segmentation failure,
 // no X display, unwritable screenshot), 2 = usage error (bad option).
 
+#include <pcl_selective_seg/regions_of_interest.h>
 #include <pcl_selective_seg/selective_segmentation.h>
 
 #include <pcl/console/parse.h>
@@ -43,10 +44,13 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "roi_json.h"
+#include "roi_options.h"
 #include "scan_io.h"
 #include "segment_colors.h"
 #include "segmentation_options.h"
@@ -66,7 +70,7 @@ using NormalCloud = pcl::PointCloud<pcl::Normal>;
 using PolyData = vtkSmartPointer<vtkPolyData>;
 
 /** The layers of the picture, in the order of the key legend. */
-enum Layer { kMesh = 0, kOctree, kCloud, kNormals, kNumLayers };
+enum Layer { kMesh = 0, kOctree, kCloud, kNormals, kRegions, kNumLayers };
 
 /** Key, name and description of each layer (keys PCLVisualizer and VTK leave free). */
 struct LayerInfo {
@@ -78,7 +82,10 @@ constexpr std::array<LayerInfo, kNumLayers> kLayers = {
     {{'t', "mesh", "mesh triangles by segment, edge triangles white"},
      {'v', "octree", "octree leaves by segment"},
      {'d', "cloud", "data points by segment"},
-     {'n', "normals", "point normals (subsampled)"}}};
+     {'n', "normals", "point normals (subsampled)"},
+     {'r',
+      "regions",
+      "regions of interest: yellow transition, magenta small segment, cyan sparse"}}};
 
 /** Every option of the tool, with its default. */
 struct Options {
@@ -86,7 +93,10 @@ struct Options {
   double unit_scale = 1.0;
   bool ignore_viewpoint = false;
   SelectiveSegmentationParameters params;
-  std::array<bool, kNumLayers> view = {true, false, false, false}; ///< shown at start
+  std::array<bool, kNumLayers> view = {true, false, false, false, true}; ///< at start
+  bool roi = false;     ///< compute regions of interest from the segmentation
+  std::string roi_json; ///< or read them from this file
+  pcl::selective_seg::RegionOfInterestParameters roi_params;
   std::string screenshot;
   int width = 1280;
   int height = 960;
@@ -101,6 +111,7 @@ struct Scene {
   Eigen::Affine3f sensor_pose = Eigen::Affine3f::Identity(); ///< sensor to cloud
   SegmentationResult result;
   NormalCloud::ConstPtr normals;
+  std::vector<pcl::selective_seg::RegionOfInterest> regions;
 };
 
 void
@@ -119,9 +130,15 @@ printHelp(const char* program)
   print_info("  -ignore_viewpoint      sensor at the origin looking along +z, whatever "
              "the file's VIEWPOINT says (default off)\n");
   selseg_apps::printSegmentationHelp();
+  print_info("Regions of interest (layer 'regions', key r):\n");
+  print_info("  -roi                   compute them from the segmentation, with the "
+             "-roi_* options below\n");
+  print_info("  -roi_json FILE         read them from a file of pcl_selective_seg "
+             "-roi_json (windows in the sensor frame)\n");
+  selseg_apps::printRegionHelp();
   print_info("Display:\n");
   print_info("  -view LAYER[,LAYER]    layers shown at start: mesh, octree, cloud, "
-             "normals (default mesh)\n");
+             "normals, regions (default mesh, and regions when given)\n");
   print_info("  -wireframe             octree leaves as outlines, not solid cubes "
              "(default solid)\n");
   print_info("  -normal_step N         draw the normal of every N-th labeled point; "
@@ -134,8 +151,9 @@ printHelp(const char* program)
              d.width,
              d.height);
   print_info("  -h, --help             this help\n\n");
-  print_info("Keys: t mesh, v octree, d data points, n normals, b solid/outline "
-             "cubes,\n      z back to the sensor's view, i legend; q quits.\n");
+  print_info("Keys: t mesh, v octree, d data points, n normals, r regions of "
+             "interest,\n      b solid/outline cubes, z back to the sensor's view, i "
+             "legend; q quits.\n");
 }
 
 /** "-size WxH": two integers in [64, 8192]. */
@@ -173,8 +191,8 @@ parseView(int argc, char** argv, Options& opt)
     const auto info = std::find_if(
         kLayers.begin(), kLayers.end(), [&name](auto& l) { return name == l.name; });
     if (info == kLayers.end()) {
-      print_error("Unknown layer '%s' in -view: use mesh, octree, cloud or normals, "
-                  "comma-separated.\n",
+      print_error("Unknown layer '%s' in -view: use mesh, octree, cloud, normals or "
+                  "regions, comma-separated.\n",
                   name.c_str());
       return false;
     }
@@ -188,17 +206,19 @@ bool
 isValueFlag(const std::string& arg)
 {
   static const std::vector<std::string> flags = {
-      "-unit_scale", "-view", "-normal_step", "-screenshot", "-size"};
+      "-unit_scale", "-view", "-normal_step", "-screenshot", "-size", "-roi_json"};
   const auto& seg = selseg_apps::segmentationFlags();
+  const auto& roi = selseg_apps::regionFlags();
   return std::find(flags.begin(), flags.end(), arg) != flags.end() ||
-         std::find(seg.begin(), seg.end(), arg) != seg.end();
+         std::find(seg.begin(), seg.end(), arg) != seg.end() ||
+         std::find(roi.begin(), roi.end(), arg) != roi.end();
 }
 
 bool
 isSwitch(const std::string& arg)
 {
   return arg == "-ignore_viewpoint" || arg == "-wireframe" || arg == "-no_legend" ||
-         arg == "-h" || arg == "--help";
+         arg == "-roi" || arg == "-h" || arg == "--help";
 }
 
 /** The one input file; every other argument must be a known option. */
@@ -236,6 +256,7 @@ parseOptions(int argc, char** argv, Options& opt)
   auto& p = opt.params;
   if (!selseg_apps::parseNumber(argc, argv, "-unit_scale", opt.unit_scale) ||
       !selseg_apps::parseSegmentationOptions(argc, argv, p) ||
+      !selseg_apps::parseRegionOptions(argc, argv, opt.roi_params) ||
       !selseg_apps::parseNumber(argc, argv, "-normal_step", opt.normal_step) ||
       !parseSize(argc, argv, opt) || !parseView(argc, argv, opt))
     return kUsageError;
@@ -248,6 +269,12 @@ parseOptions(int argc, char** argv, Options& opt)
     return kUsageError;
   }
   parse_argument(argc, argv, "-screenshot", opt.screenshot);
+  parse_argument(argc, argv, "-roi_json", opt.roi_json);
+  opt.roi = find_switch(argc, argv, "-roi");
+  if (opt.roi && !opt.roi_json.empty()) {
+    print_error("Give -roi or -roi_json, not both.\n");
+    return kUsageError;
+  }
   opt.ignore_viewpoint = find_switch(argc, argv, "-ignore_viewpoint");
   opt.octree_wireframe = find_switch(argc, argv, "-wireframe");
   opt.legend = !find_switch(argc, argv, "-no_legend");
@@ -296,6 +323,30 @@ segment(const Options& opt, Scene& scene)
   }
   scene.result = seg.getResult();
   scene.normals = seg.getPointNormals();
+  if (opt.roi) {
+    pcl::selective_seg::RegionOfInterestStats stats;
+    if (!pcl::selective_seg::computeRegionsOfInterest(scene.result,
+                                                      seg.getTriangulation(),
+                                                      scene.sensor_pose,
+                                                      opt.roi_params,
+                                                      scene.regions,
+                                                      &stats)) {
+      print_error("Computing the regions of interest failed (reason above).\n");
+      return false;
+    }
+    print_info("Regions of interest: %zu chosen of %zu candidates\n",
+               stats.selected,
+               stats.candidates);
+  } else if (!opt.roi_json.empty()) {
+    std::string error;
+    if (!selseg_apps::readRegionsJson(opt.roi_json, scene.regions, error)) {
+      print_error("%s\n", error.c_str());
+      return false;
+    }
+    print_info("Read %zu regions of interest from '%s'\n",
+               scene.regions.size(),
+               opt.roi_json.c_str());
+  }
   print_info("Segmented [done, %g ms : %zu segments, %zu octree leaves, %zu "
              "triangles]\n",
              timer.toc(),
@@ -459,6 +510,51 @@ buildNormals(const Scene& scene, int step)
   return data;
 }
 
+/** Each region of interest as the outline of its angular window, drawn on a plane in
+ * front of the nearest labeled point (so that it is never hidden), coloured by its
+ * first reason: yellow transition, magenta small segment, cyan sparse. */
+PolyData
+buildRegions(const Scene& scene)
+{
+  const Eigen::Affine3f to_sensor = scene.sensor_pose.inverse();
+  float depth = std::numeric_limits<float>::infinity();
+  for (std::size_t i = 0; i < scene.cloud->size(); ++i)
+    if (scene.result.labels[i] != 0)
+      depth = std::min(depth, (to_sensor * (*scene.cloud)[i].getVector3fMap()).z());
+  depth = std::isfinite(depth) ? 0.9f * depth : 1.0f;
+  auto points = vtkSmartPointer<vtkPoints>::New();
+  auto cells = vtkSmartPointer<vtkCellArray>::New();
+  auto colors = newColors(0);
+  for (const auto& r : scene.regions) {
+    const double corners[4][2] = {{r.theta_min, r.phi_min},
+                                  {r.theta_max, r.phi_min},
+                                  {r.theta_max, r.phi_max},
+                                  {r.theta_min, r.phi_max}};
+    vtkIdType ids[5];
+    for (int c = 0; c < 4; ++c) {
+      const Eigen::Vector3f ray(static_cast<float>(std::tan(corners[c][0])),
+                                static_cast<float>(std::tan(corners[c][1])),
+                                1.0f);
+      const Eigen::Vector3f p = scene.sensor_pose * (depth * ray);
+      ids[c] = points->InsertNextPoint(p.data());
+    }
+    ids[4] = ids[0];
+    cells->InsertNextCell(5, ids);
+    const std::array<unsigned char, 3> rgb =
+        (r.reasons & pcl::selective_seg::kTransition)
+            ? std::array<unsigned char, 3>{255, 230, 0}
+        : (r.reasons & pcl::selective_seg::kSmallSegment)
+            ? std::array<unsigned char, 3>{255, 0, 255}
+            : std::array<unsigned char, 3>{0, 230, 255};
+    colors->InsertNextTypedTuple(rgb.data());
+  }
+  auto data = PolyData::New();
+  data->SetPoints(points);
+  data->SetLines(cells);
+  data->GetCellData()->SetScalars(colors);
+  return data;
+}
+
 /** An actor drawing the data's cell colours as they are. */
 vtkSmartPointer<vtkActor>
 newActor(const PolyData& data)
@@ -571,7 +667,8 @@ SegmentationViewer::SegmentationViewer(const Scene& scene,
   const std::array<PolyData, kNumLayers> data = {buildMesh(scene),
                                                  buildOctree(scene),
                                                  buildCloud(scene),
-                                                 buildNormals(scene, opt.normal_step)};
+                                                 buildNormals(scene, opt.normal_step),
+                                                 buildRegions(scene)};
   for (int layer = 0; layer < kNumLayers; ++layer) {
     actors_[layer] = newActor(data[layer]);
     visible_[layer] = opt.view[layer];
@@ -584,11 +681,17 @@ SegmentationViewer::SegmentationViewer(const Scene& scene,
   }
   actors_[kCloud]->GetProperty()->SetPointSize(2.0);
   actors_[kNormals]->GetProperty()->LightingOff();
+  actors_[kRegions]->GetProperty()->LightingOff();
+  actors_[kRegions]->GetProperty()->SetLineWidth(2.0f);
   actors_[kOctree]->GetProperty()->SetEdgeColor(0.1, 0.1, 0.1);
   setOctreeWireframe(opt.octree_wireframe);
-  summary_ = std::to_string(scene.result.segments.size()) + " segments, " +
-             std::to_string(scene.result.leaves.size()) + " octree leaves, " +
-             std::to_string(scene.result.mesh.triangles.size()) + " triangles";
+  summary_ =
+      std::to_string(scene.result.segments.size()) + " segments, " +
+      std::to_string(scene.result.leaves.size()) + " octree leaves, " +
+      std::to_string(scene.result.mesh.triangles.size()) + " triangles" +
+      (scene.regions.empty() && opt.roi_json.empty() && !opt.roi
+           ? std::string()
+           : ", " + std::to_string(scene.regions.size()) + " regions of interest");
   updateLegend();
   setSensorCamera();
   if (!offscreen)

@@ -492,6 +492,118 @@ objectMetrics(const pcl::PointCloud<pcl::PointXYZ>& cloud,
   return true;
 }
 
+bool
+labelBoundaryPoints(const pcl::PointCloud<pcl::PointXYZ>& cloud,
+                    const std::vector<std::array<pcl::index_t, 3>>& triangles,
+                    const std::vector<std::uint32_t>& labels,
+                    const Eigen::Vector3f& sensor_origin,
+                    double max_edge_angle,
+                    pcl::Indices& boundary)
+{
+  boundary.clear();
+  const std::size_t n = cloud.size();
+  if (labels.size() != n) {
+    PCL_ERROR("[pcl::selective_seg::metrics::labelBoundaryPoints] points (%zu) and "
+              "labels (%zu) differ\n",
+              n,
+              labels.size());
+    return false;
+  }
+  if (!(max_edge_angle > 0.0) || !sensor_origin.allFinite()) {
+    PCL_ERROR("[pcl::selective_seg::metrics::labelBoundaryPoints] max edge angle %g "
+              "must be > 0 [rad] and the sensor origin finite\n",
+              max_edge_angle);
+    return false;
+  }
+  for (const auto& t : triangles)
+    for (const auto v : t)
+      if (v < 0 || static_cast<std::size_t>(v) >= n) {
+        PCL_ERROR("[pcl::selective_seg::metrics::labelBoundaryPoints] triangle vertex "
+                  "%d out of range [0, %zu)\n",
+                  static_cast<int>(v),
+                  n);
+        return false;
+      }
+  const double cos_max = max_edge_angle >= M_PI ? -2.0 : std::cos(max_edge_angle);
+  std::vector<char> is_boundary(n, 0);
+  for (const auto& t : triangles)
+    for (int k = 0; k < 3; ++k) {
+      const pcl::index_t a = t[k];
+      const pcl::index_t b = t[(k + 1) % 3];
+      if (labels[a] == labels[b])
+        continue;
+      const Eigen::Vector3d ra =
+          (cloud[a].getVector3fMap() - sensor_origin).cast<double>();
+      const Eigen::Vector3d rb =
+          (cloud[b].getVector3fMap() - sensor_origin).cast<double>();
+      if (!ra.allFinite() || !rb.allFinite())
+        continue;
+      const double na = ra.norm();
+      const double nb = rb.norm();
+      if (!(na > 0.0 && nb > 0.0) || ra.dot(rb) < cos_max * na * nb)
+        continue;
+      const bool a_nearer = na < nb || (na == nb && a < b);
+      is_boundary[a_nearer ? a : b] = 1;
+    }
+  for (std::size_t i = 0; i < n; ++i)
+    if (is_boundary[i])
+      boundary.push_back(static_cast<pcl::index_t>(i));
+  return true;
+}
+
+void
+boundaryDistances(const pcl::PointCloud<pcl::PointXYZ>& from,
+                  const pcl::PointCloud<pcl::PointXYZ>& to,
+                  BoundaryDistances& result,
+                  std::vector<float>* per_point)
+{
+  result = BoundaryDistances{};
+  if (per_point)
+    per_point->assign(from.size(), std::numeric_limits<float>::quiet_NaN());
+  auto targets = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  for (const auto& p : to)
+    if (pcl::isFinite(p))
+      targets->push_back(p);
+  result.num_to = targets->size();
+  std::vector<double> distances;
+  distances.reserve(from.size());
+  if (!targets->empty()) {
+    pcl::search::KdTree<pcl::PointXYZ> tree;
+    tree.setInputCloud(targets);
+    pcl::Indices index(1);
+    std::vector<float> sqr(1);
+    for (std::size_t i = 0; i < from.size(); ++i) {
+      const auto& p = from[i];
+      if (!pcl::isFinite(p) || tree.nearestKSearch(p, 1, index, sqr) != 1)
+        continue;
+      distances.push_back(((*targets)[index[0]].getVector3fMap() - p.getVector3fMap())
+                              .cast<double>()
+                              .norm());
+      if (per_point)
+        (*per_point)[i] = static_cast<float>(distances.back());
+    }
+  } else
+    for (const auto& p : from)
+      if (pcl::isFinite(p))
+        distances.push_back(kNaN);
+  result.num_from = distances.size();
+  if (distances.empty() || targets->empty()) {
+    result.mean = result.median = result.p90 = result.max = kNaN;
+    return;
+  }
+  std::sort(distances.begin(), distances.end());
+  const auto rank = [&](double q) {
+    const auto k = static_cast<std::size_t>(
+        std::ceil(q * static_cast<double>(distances.size()) - 1e-9));
+    return distances[std::min(distances.size(), std::max<std::size_t>(k, 1)) - 1];
+  };
+  result.mean = std::accumulate(distances.begin(), distances.end(), 0.0) /
+                static_cast<double>(distances.size());
+  result.median = rank(0.5);
+  result.p90 = rank(0.9);
+  result.max = distances.back();
+}
+
 } // namespace metrics
 } // namespace selective_seg
 } // namespace pcl

@@ -759,6 +759,93 @@ SensorSimulator::simulate(const Scene& scene,
   return true;
 }
 
+bool
+ScanWindow::validate(std::string* why) const
+{
+  const double limit = 0.5 * kPi;
+  if (!(theta_min > -limit && theta_min < theta_max && theta_max < limit))
+    return fail(why,
+                "scan window theta_min " + std::to_string(theta_min) + ", theta_max " +
+                    std::to_string(theta_max) +
+                    ": need -pi/2 < theta_min < theta_max < pi/2 [rad]");
+  if (!(phi_min > -limit && phi_min < phi_max && phi_max < limit))
+    return fail(why,
+                "scan window phi_min " + std::to_string(phi_min) + ", phi_max " +
+                    std::to_string(phi_max) +
+                    ": need -pi/2 < phi_min < phi_max < pi/2 [rad]");
+  if (!(step > 0.0) || !std::isfinite(step))
+    return reject(why, "scan window step", step, "(0, inf) [rad]");
+  const double cells = std::ceil((theta_max - theta_min) / step + 0.5) *
+                       std::ceil((phi_max - phi_min) / step + 0.5);
+  if (!(cells <= 1e8))
+    return reject(why,
+                  "scan window step",
+                  step,
+                  "large enough for at most 1e8 grid cells over the window [rad]");
+  return true;
+}
+
+bool
+SensorSimulator::simulateWindow(const Scene& scene,
+                                const ScanWindow& window,
+                                pcl::PointCloud<pcl::PointXYZL>& cloud,
+                                SimulationDetails* details) const
+{
+  cloud.clear();
+  cloud.height = 1;
+  cloud.width = 0;
+  SimulationDetails local;
+  SimulationDetails& d = details ? *details : local;
+  d = SimulationDetails();
+  std::string why;
+  if (!validateScene(scene, &why) || !window.validate(&why)) {
+    PCL_ERROR("[pcl::selective_seg::simulation::SensorSimulator::simulateWindow] %s\n",
+              why.c_str());
+    return false;
+  }
+  // Streams of their own, seeded with the window's id: a window scan never repeats
+  // the rays of simulate() or of another id.
+  const auto engine = [&](std::uint32_t stream) {
+    std::seed_seq sequence{params_.seed, stream, window.scan_id, 0x57696e64u};
+    return std::mt19937(sequence);
+  };
+  std::mt19937 grid_engine = engine(kGridStream);
+  std::mt19937 dropout_engine = engine(kDropoutStream);
+  std::mt19937 noise_engine = engine(kNoiseStream);
+  const double width = window.theta_max - window.theta_min;
+  const double height = window.phi_max - window.phi_min;
+  const long columns = std::max(1L, std::lround(width / window.step));
+  const long rows = std::max(1L, std::lround(height / window.step));
+  const double cell_width = width / columns;
+  const double cell_height = height / rows;
+  for (long row = 0; row < rows; ++row)
+    for (long column = 0; column < columns; ++column) {
+      const double du = params_.jitter * (uniform01(grid_engine) - 0.5);
+      const double dv = params_.jitter * (uniform01(grid_engine) - 0.5);
+      const double accept = uniform01(grid_engine);
+      const double theta = window.theta_min + (column + 0.5 + du) * cell_width;
+      const double phi = window.phi_min + (row + 0.5 + dv) * cell_height;
+      const bool dropped = uniform01(dropout_engine) < params_.dropout;
+      const double deviate = standardNormal(noise_engine);
+      if (!(accept < getRelativeDensity(theta, phi)))
+        continue;
+      ++d.rays;
+      if (isInHole(theta, phi))
+        ++d.in_holes;
+      else if (dropped)
+        ++d.dropped;
+      else
+        castOne(scene, {theta, phi}, deviate, cloud, d);
+    }
+  d.candidates = static_cast<std::size_t>(rows * columns);
+  cloud.width = static_cast<std::uint32_t>(cloud.size());
+  cloud.height = 1;
+  cloud.is_dense = true;
+  cloud.sensor_origin_ = Eigen::Vector4f::Zero();
+  cloud.sensor_orientation_ = Eigen::Quaternionf::Identity();
+  return true;
+}
+
 namespace {
 
 /** Expected rays of each paper scene at density 1: the paper's point count divided by

@@ -6,10 +6,12 @@
 
 #pragma once
 
+#include <Eigen/Core>
 #include <pcl/pcl_macros.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -286,6 +288,64 @@ PCL_EXPORTS bool objectMetrics(const pcl::PointCloud<pcl::PointXYZ>& cloud,
                                const std::vector<std::uint32_t>& ground_truth,
                                const ObjectMetricsParams& params,
                                ObjectScores& scores);
+
+/** \brief The boundary points of a labelling of a triangulated scan.
+ *
+ * A boundary edge is a mesh edge (a side of a triangle) whose two end points both have
+ * finite coordinates, have different labels, at least one of them nonzero, and subtend
+ * at most \a max_edge_angle at the sensor (the angle between the two rays from
+ * \a sensor_origin; this leaves out the long edges across holes and sparse regions).
+ * Its boundary point is the end point nearer to the sensor (on a ties the smaller
+ * index): at a depth jump that is the point on the occluding contour, at a crease a
+ * point on one of the two faces. The result lists each boundary point once.
+ *
+ * \param[in] cloud #N points [m]
+ * \param[in] triangles mesh triangles over point indices in [0, N)
+ * \param[in] labels #N labels (predicted or ground truth)
+ * \param[in] sensor_origin the sensor's position in the cloud's frame [m]
+ * \param[in] max_edge_angle largest angle an edge subtends at the sensor [rad], > 0
+ *            (infinity: every edge)
+ * \param[out] boundary indices of the boundary points, increasing; empty on failure
+ * \return false (with PCL_ERROR) on a size mismatch, an index out of range or a bad
+ *         angle
+ */
+PCL_EXPORTS bool
+labelBoundaryPoints(const pcl::PointCloud<pcl::PointXYZ>& cloud,
+                    const std::vector<std::array<pcl::index_t, 3>>& triangles,
+                    const std::vector<std::uint32_t>& labels,
+                    const Eigen::Vector3f& sensor_origin,
+                    double max_edge_angle,
+                    pcl::Indices& boundary);
+
+/** \brief Distances from one set of boundary points to the nearest point of another. */
+struct BoundaryDistances {
+  std::size_t num_from = 0; ///< points measured (the "from" set)
+  std::size_t num_to = 0;   ///< points of the "to" set
+  double mean = 0.0;        ///< mean distance [m]; NaN when a set is empty
+  double median = 0.0;      ///< 50th percentile [m] (nearest rank); NaN likewise
+  double p90 = 0.0;         ///< 90th percentile [m] (nearest rank); NaN likewise
+  double max = 0.0;         ///< largest distance [m]; NaN likewise
+};
+
+/** \brief For every point of \a from, the Euclidean distance to the nearest point of
+ * \a to; their mean, median, 90th percentile and maximum.
+ *
+ * Boundary accuracy (docs/selective_sensing.md) is this with \a from the ground-truth
+ * boundary points of a very dense reference scan and \a to the predicted boundary
+ * points (labelBoundaryPoints() of both): how far each true edge lies from the nearest
+ * segment boundary. The reverse direction measures spurious boundaries.
+ * Percentiles use the nearest rank: the value at position ceil(q n) of the sorted
+ * distances.
+ * \param[in] from points to measure [m]; non-finite points are skipped
+ * \param[in] to points to measure to [m]; non-finite points are skipped
+ * \param[out] result the statistics
+ * \param[out] per_point if non-null: the distance of every point of \a from, in its
+ *             order (NaN for skipped points or an empty \a to)
+ */
+PCL_EXPORTS void boundaryDistances(const pcl::PointCloud<pcl::PointXYZ>& from,
+                                   const pcl::PointCloud<pcl::PointXYZ>& to,
+                                   BoundaryDistances& result,
+                                   std::vector<float>* per_point = nullptr);
 
 } // namespace metrics
 } // namespace selective_seg

@@ -339,6 +339,29 @@ struct SimulationDetails {
   std::vector<double> exact_ranges;
 };
 
+/** \brief An angular window of the view scanned at a chosen angular step (selective
+ * sensing: a finer acquisition of a region of interest). Angles as in eq. 1 [rad]. */
+struct PCL_EXPORTS ScanWindow {
+  /** \brief Smallest horizontal angle [rad], in (-pi/2, theta_max). */
+  double theta_min = -0.1;
+  /** \brief Largest horizontal angle [rad], in (theta_min, pi/2). */
+  double theta_max = 0.1;
+  /** \brief Smallest vertical angle [rad], in (-pi/2, phi_max). */
+  double phi_min = -0.1;
+  /** \brief Largest vertical angle [rad], in (phi_min, pi/2). */
+  double phi_max = 0.1;
+  /** \brief Spacing of the candidate ray grid in both angles [rad], > 0; the grid has
+   * at most 1e8 cells. */
+  double step = 0.01;
+  /** \brief Mixed into the seed of the window's grid, dropout and noise streams, so
+   * that repeated scans of one window (or overlapping windows) draw new rays; equal
+   * windows with equal ids give identical clouds. */
+  std::uint32_t scan_id = 0;
+
+  /** \brief Check every field; \a why as SensorParameters::validate(). */
+  bool validate(std::string* why = nullptr) const;
+};
+
 /** \brief Simulated stereo-like range sensor at the origin (identity orientation).
  *
  * \code
@@ -394,6 +417,24 @@ public:
   bool simulate(const Scene& scene,
                 pcl::PointCloud<pcl::PointXYZL>& cloud,
                 SimulationDetails* details = nullptr) const;
+
+  /** \brief Scan one angular window at a chosen angular step.
+   *
+   * The same sensor as simulate() (texture field and holes of the current parameters,
+   * which stay fixed in the view whatever the window; dropouts; range noise; range
+   * limits), but the candidate rays lie on a jittered grid of \a window.step over the
+   * window instead of num_rays over the view window of the parameters. The texture
+   * field then keeps a fraction of them, as in simulate(). simulate() is unchanged.
+   * \param[in] scene surfaces to scan.
+   * \param[in] window the window, step and scan id.
+   * \param[out] cloud as simulate().
+   * \param[out] details as simulate().
+   * \return false (empty cloud, with a PCL_ERROR saying why) when the scene or the
+   *         window is invalid. */
+  bool simulateWindow(const Scene& scene,
+                      const ScanWindow& window,
+                      pcl::PointCloud<pcl::PointXYZL>& cloud,
+                      SimulationDetails* details = nullptr) const;
 
 private:
   /** \brief One plane wave of the texture field, in window-normalized coordinates. */

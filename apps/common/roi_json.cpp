@@ -1,0 +1,182 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
+ */
+
+#include "roi_json.h"
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+
+namespace selseg_apps {
+
+using pcl::selective_seg::RegionOfInterest;
+
+namespace {
+
+void
+putVector(std::ostream& out, const Eigen::Vector3f& v)
+{
+  out << "[" << v.x() << ", " << v.y() << ", " << v.z() << "]";
+}
+
+/** The number after "key": inside [begin, end) of text, or false. */
+bool
+findNumber(const std::string& text,
+           std::size_t begin,
+           std::size_t end,
+           const std::string& key,
+           double& value)
+{
+  const std::size_t at = text.find("\"" + key + "\":", begin);
+  if (at == std::string::npos || at >= end)
+    return false;
+  const char* start = text.c_str() + at + key.size() + 3;
+  char* stop = nullptr;
+  value = std::strtod(start, &stop);
+  return stop != start && std::isfinite(value);
+}
+
+bool
+findVector(const std::string& text,
+           std::size_t begin,
+           std::size_t end,
+           const std::string& key,
+           Eigen::Vector3f& v)
+{
+  std::size_t at = text.find("\"" + key + "\":", begin);
+  if (at == std::string::npos || at >= end)
+    return false;
+  at = text.find('[', at);
+  if (at == std::string::npos || at >= end)
+    return false;
+  const char* p = text.c_str() + at + 1;
+  for (int k = 0; k < 3; ++k) {
+    char* stop = nullptr;
+    v[k] = std::strtof(p, &stop);
+    if (stop == p)
+      return false;
+    p = stop;
+    while (*p == ',' || *p == ' ')
+      ++p;
+  }
+  return true;
+}
+
+} // namespace
+
+bool
+writeRegionsJson(const std::string& path,
+                 const std::string& input,
+                 const pcl::selective_seg::RegionOfInterestParameters& p,
+                 const pcl::selective_seg::RegionOfInterestStats& s,
+                 const std::vector<RegionOfInterest>& regions)
+{
+  std::ofstream out(path);
+  out << std::setprecision(9) << "{\n  \"input\": \"";
+  for (const char c : input) {
+    if (c == '"' || c == '\\')
+      out << '\\';
+    if (static_cast<unsigned char>(c) >= 0x20)
+      out << c;
+  }
+  out << "\",\n  \"frames\": \"windows: sensor frame, theta = atan2(x, z), phi = "
+         "atan2(y, z) [rad]; boxes: cloud frame [m]\",\n"
+      << "  \"budget\": {\"max_solid_angle_sr\": " << p.max_solid_angle
+      << ", \"max_points\": " << p.max_points << ", \"max_regions\": " << p.max_regions
+      << ", \"target_step_rad\": " << p.target_step
+      << ", \"sample_yield\": " << p.sample_yield << "},\n"
+      << "  \"counts\": {\"transition_vertices\": " << s.transition_vertices
+      << ", \"small_segment_vertices\": " << s.small_segment_vertices
+      << ", \"sparse_vertices\": " << s.sparse_vertices
+      << ", \"candidates\": " << s.candidates
+      << ", \"already_fine\": " << s.already_fine
+      << ", \"over_budget\": " << s.over_budget << ", \"selected\": " << s.selected
+      << ", \"selected_solid_angle_sr\": " << s.selected_solid_angle
+      << ", \"selected_points\": " << s.selected_points << "},\n  \"regions\": [";
+  for (std::size_t i = 0; i < regions.size(); ++i) {
+    const auto& r = regions[i];
+    out << (i ? ",\n    " : "\n    ") << "{\"theta_min\": " << r.theta_min
+        << ", \"theta_max\": " << r.theta_max << ", \"phi_min\": " << r.phi_min
+        << ", \"phi_max\": " << r.phi_max << ", \"box_min\": ";
+    putVector(out, r.box_min);
+    out << ", \"box_max\": ";
+    putVector(out, r.box_max);
+    out << ", \"priority\": " << r.priority
+        << ", \"suggested_step\": " << r.suggested_step
+        << ", \"current_step\": " << r.current_step << ", \"reasons\": \""
+        << pcl::selective_seg::reasonsToString(r.reasons)
+        << "\", \"evidence\": " << r.num_evidence << ", \"points\": " << r.num_points
+        << ", \"estimated_points\": " << r.estimated_points
+        << ", \"solid_angle_sr\": " << r.solid_angle << "}";
+  }
+  out << "\n  ]\n}\n";
+  out.close();
+  return static_cast<bool>(out);
+}
+
+bool
+readRegionsJson(const std::string& path,
+                std::vector<RegionOfInterest>& regions,
+                std::string& error)
+{
+  regions.clear();
+  std::ifstream in(path);
+  if (!in) {
+    error = "Cannot read '" + path + "'.";
+    return false;
+  }
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  const std::string text = buffer.str();
+  std::size_t at = text.find("\"regions\":");
+  if (at == std::string::npos) {
+    error = "'" + path + "' has no \"regions\" list (write it with -roi_json).";
+    return false;
+  }
+  const std::size_t list_end = text.rfind(']'); // the regions list comes last
+  while ((at = text.find('{', at)) != std::string::npos) {
+    const std::size_t end = text.find('}', at);
+    if (end == std::string::npos || end > list_end)
+      break;
+    RegionOfInterest r;
+    double step = 0.0, current = 0.0, priority = 0.0;
+    if (!findNumber(text, at, end, "theta_min", r.theta_min) ||
+        !findNumber(text, at, end, "theta_max", r.theta_max) ||
+        !findNumber(text, at, end, "phi_min", r.phi_min) ||
+        !findNumber(text, at, end, "phi_max", r.phi_max) ||
+        !(r.theta_min < r.theta_max && r.phi_min < r.phi_max)) {
+      error = "'" + path + "': region " + std::to_string(regions.size() + 1) +
+              " needs theta_min < theta_max and phi_min < phi_max.";
+      regions.clear();
+      return false;
+    }
+    findVector(text, at, end, "box_min", r.box_min);
+    findVector(text, at, end, "box_max", r.box_max);
+    if (findNumber(text, at, end, "priority", priority))
+      r.priority = priority;
+    if (findNumber(text, at, end, "suggested_step", step))
+      r.suggested_step = step;
+    if (findNumber(text, at, end, "current_step", current))
+      r.current_step = current;
+    const std::size_t reasons = text.find("\"reasons\":", at);
+    if (reasons != std::string::npos && reasons < end) {
+      const std::string value = text.substr(reasons, end - reasons);
+      if (value.find("transition") != std::string::npos)
+        r.reasons |= pcl::selective_seg::kTransition;
+      if (value.find("small_segment") != std::string::npos)
+        r.reasons |= pcl::selective_seg::kSmallSegment;
+      if (value.find("sparse") != std::string::npos)
+        r.reasons |= pcl::selective_seg::kSparse;
+    }
+    regions.push_back(r);
+    at = end;
+  }
+  return true;
+}
+
+} // namespace selseg_apps

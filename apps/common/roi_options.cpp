@@ -1,0 +1,174 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
+ */
+
+#include "roi_options.h"
+
+#include <pcl/console/parse.h>
+#include <pcl/console/print.h>
+
+#include <cmath>
+
+#include "segmentation_options.h"
+
+namespace selseg_apps {
+
+namespace {
+constexpr double kDeg = M_PI / 180.0;
+} // namespace
+
+const std::vector<std::string>&
+regionFlags()
+{
+  static const std::vector<std::string> flags = {"-roi_max_sr",
+                                                 "-roi_max_points",
+                                                 "-roi_max_regions",
+                                                 "-roi_yield",
+                                                 "-roi_step_deg",
+                                                 "-roi_refine",
+                                                 "-roi_max_window_deg",
+                                                 "-roi_min_window_deg",
+                                                 "-roi_margin_deg",
+                                                 "-roi_margin_spacings",
+                                                 "-roi_small_points",
+                                                 "-roi_min_component",
+                                                 "-roi_valid_edges",
+                                                 "-roi_sparse_factor",
+                                                 "-roi_leaf_sigma_deg",
+                                                 "-roi_weights"};
+  return flags;
+}
+
+void
+printRegionHelp()
+{
+  const pcl::selective_seg::RegionOfInterestParameters d;
+  pcl::console::print_info(
+      "Regions of interest (with -roi_json; budgets of 0 = no limit):\n"
+      "  -roi_max_sr X            total solid angle of the chosen windows [sr] "
+      "(default %g)\n"
+      "  -roi_max_points N        total estimated points of the chosen windows "
+      "(default %zu)\n"
+      "  -roi_max_regions N       number of windows (default %zu)\n"
+      "  -roi_yield F             fraction of the rays that return a point, for the "
+      "estimate (default %g)\n"
+      "  -roi_step_deg X          angular step of the finer scan; 0 = current "
+      "spacing / -roi_refine (default %g)\n"
+      "  -roi_refine X            refinement of the step when -roi_step_deg is 0 "
+      "(default %g)\n"
+      "  -roi_max_window_deg X    largest window side (default %g)\n"
+      "  -roi_min_window_deg X    smallest window side (default %g)\n"
+      "  -roi_margin_deg X        margin around the evidence (default %g)\n"
+      "  -roi_margin_spacings X   margin in units of the local spacing (default %g)\n"
+      "  -roi_small_points N      segments with fewer points are evidence; 0 = off "
+      "(default %zu)\n"
+      "  -roi_valid_edges 0|1     valid edge triangles (segment borders) are "
+      "transition evidence too (default %d)\n"
+      "  -roi_min_component N     evidence in mesh-connected groups of fewer vertices "
+      "is ignored (default %zu)\n"
+      "  -roi_sparse_factor X     spacing above X times the median is evidence; 0 = "
+      "off (default %g)\n"
+      "  -roi_leaf_sigma_deg X    finest leaves with a larger normal spread are "
+      "evidence; 0 = off (default %g)\n"
+      "  -roi_weights I,L,V,S,P   priority weights of transition evidence from "
+      "invalid edges, leaves, valid\n"
+      "                           edges, and of small-segment and sparse evidence "
+      "(default %g,%g,%g,%g,%g)\n\n",
+      d.max_solid_angle,
+      d.max_points,
+      d.max_regions,
+      d.sample_yield,
+      d.target_step / kDeg,
+      d.refinement_factor,
+      d.max_window_size / kDeg,
+      d.min_window_size / kDeg,
+      d.margin / kDeg,
+      d.margin_spacings,
+      d.small_segment_points,
+      d.use_valid_edges ? 1 : 0,
+      d.min_component_vertices,
+      d.sparse_factor,
+      d.leaf_sigma_threshold / kDeg,
+      d.transition_weight,
+      d.leaf_weight,
+      d.valid_edge_weight,
+      d.small_segment_weight,
+      d.sparse_weight);
+}
+
+bool
+parseRegionOptions(int argc,
+                   char** argv,
+                   pcl::selective_seg::RegionOfInterestParameters& p)
+{
+  double step = p.target_step / kDeg, max_window = p.max_window_size / kDeg,
+         min_window = p.min_window_size / kDeg, margin = p.margin / kDeg,
+         sigma = p.leaf_sigma_threshold / kDeg;
+  double max_points = static_cast<double>(p.max_points),
+         max_regions = static_cast<double>(p.max_regions),
+         small = static_cast<double>(p.small_segment_points),
+         component = static_cast<double>(p.min_component_vertices),
+         valid_edges = p.use_valid_edges ? 1.0 : 0.0;
+  if (!parseNumber(argc, argv, "-roi_max_sr", p.max_solid_angle) ||
+      !parseNumber(argc, argv, "-roi_max_points", max_points) ||
+      !parseNumber(argc, argv, "-roi_max_regions", max_regions) ||
+      !parseNumber(argc, argv, "-roi_yield", p.sample_yield) ||
+      !parseNumber(argc, argv, "-roi_step_deg", step) ||
+      !parseNumber(argc, argv, "-roi_refine", p.refinement_factor) ||
+      !parseNumber(argc, argv, "-roi_max_window_deg", max_window) ||
+      !parseNumber(argc, argv, "-roi_min_window_deg", min_window) ||
+      !parseNumber(argc, argv, "-roi_margin_deg", margin) ||
+      !parseNumber(argc, argv, "-roi_margin_spacings", p.margin_spacings) ||
+      !parseNumber(argc, argv, "-roi_small_points", small) ||
+      !parseNumber(argc, argv, "-roi_min_component", component) ||
+      !parseNumber(argc, argv, "-roi_valid_edges", valid_edges) ||
+      !parseNumber(argc, argv, "-roi_sparse_factor", p.sparse_factor) ||
+      !parseNumber(argc, argv, "-roi_leaf_sigma_deg", sigma))
+    return false;
+  for (const auto& [flag, value] : {std::make_pair("-roi_max_points", max_points),
+                                    std::make_pair("-roi_max_regions", max_regions),
+                                    std::make_pair("-roi_small_points", small),
+                                    std::make_pair("-roi_min_component", component)})
+    if (!(value >= 0.0 && value <= 1e15 && value == std::floor(value))) {
+      pcl::console::print_error("Option %s needs a whole number >= 0.\n", flag);
+      return false;
+    }
+  if (pcl::console::find_argument(argc, argv, "-roi_weights") >= 0) {
+    std::vector<double> w;
+    if (pcl::console::parse_x_arguments(argc, argv, "-roi_weights", w) < 0 ||
+        w.size() != 5) {
+      pcl::console::print_error(
+          "Option -roi_weights needs 5 comma-separated numbers.\n");
+      return false;
+    }
+    p.transition_weight = w[0];
+    p.leaf_weight = w[1];
+    p.valid_edge_weight = w[2];
+    p.small_segment_weight = w[3];
+    p.sparse_weight = w[4];
+  }
+  p.max_points = static_cast<std::size_t>(max_points);
+  p.max_regions = static_cast<std::size_t>(max_regions);
+  p.small_segment_points = static_cast<std::size_t>(small);
+  p.min_component_vertices = static_cast<std::size_t>(component);
+  if (valid_edges != 0.0 && valid_edges != 1.0) {
+    pcl::console::print_error("Option -roi_valid_edges needs 0 or 1.\n");
+    return false;
+  }
+  p.use_valid_edges = valid_edges == 1.0;
+  p.target_step = step * kDeg;
+  p.max_window_size = max_window * kDeg;
+  p.min_window_size = min_window * kDeg;
+  p.margin = margin * kDeg;
+  p.leaf_sigma_threshold = sigma * kDeg;
+  std::string why;
+  if (!p.validate(&why)) {
+    pcl::console::print_error("Region of interest %s.\n", why.c_str());
+    return false;
+  }
+  return true;
+}
+
+} // namespace selseg_apps

@@ -1,0 +1,400 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
+ */
+
+// pcl_selective_seg_selective_loop: the simulated coarse-to-fine loop of selective
+// sensing on the paper's scenes, against uniform scans of the same scenes
+// (docs/selective_sensing.md). For each scene: a noise-free reference scan gives the
+// ground-truth boundaries; uniform scans at several steps and the selective loop
+// (coarse scan, regions of interest under a point budget, finer scans, update) are
+// segmented and scored. Writes OUT/table.md, OUT/<scene>.dat (gnuplot), the clouds and
+// windows for the pictures (OUT/<scene>_*.pcd, *.json) and OUT/<scene>_min_voxel.txt.
+//
+// Exit codes: 0 = success, 1 = runtime error, 2 = usage error.
+
+#include <pcl_selective_seg/selective_loop.h>
+
+#include <pcl/console/parse.h>
+#include <pcl/console/print.h>
+#include <pcl/io/pcd_io.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "roi_json.h"
+#include "roi_options.h"
+#include "segmentation_options.h"
+
+using namespace pcl::console;
+namespace sim = pcl::selective_seg::simulation;
+using pcl::selective_seg::RegionOfInterest;
+
+namespace {
+
+constexpr int kRuntimeError = 1;
+constexpr int kUsageError = 2;
+
+struct Options {
+  std::vector<std::string> scenes = {"cube", "chair", "door"};
+  std::string out;
+  int iterations = 3;
+  double coarse_factor = 3.0;
+  double budget_fraction = 0.3;
+  double range_noise = 0.0005;
+  double min_voxel_factor = 2.0;
+  double step_scale = 1.0;
+  double window_steps = 2.0;
+  double progressive = 1.0;
+  pcl::selective_seg::RegionOfInterestParameters regions;
+  pcl::selective_seg::SelectiveSegmentationParameters segmentation;
+};
+
+/** Finest step of each scene [rad]: about four times the paper's point count. */
+double
+fineStep(const std::string& scene)
+{
+  if (scene == "cube")
+    return 0.0036;
+  if (scene == "chair")
+    return 0.0032;
+  return 0.0016; // door
+}
+
+void
+printHelp(const char* program)
+{
+  print_info(
+      "The simulated coarse-to-fine loop of selective sensing against uniform "
+      "scans.\n\n"
+      "Usage: %s -out FOLDER [options]\n"
+      "  -out FOLDER            where table.md, <scene>.dat, clouds and windows go "
+      "(must exist)\n"
+      "  -scenes a,b            scenes among cube, chair, door (default all three)\n"
+      "  -iterations N          refinement rounds (default 3)\n"
+      "  -coarse_factor X       coarse step = X times the fine step (default 3)\n"
+      "  -budget_fraction F     selective point budget, fraction of the finest uniform "
+      "scan's points (default 0.3)\n"
+      "  -range_noise K         range noise sigma = K r^2 [1/m] (default 0.0005, "
+      "level A)\n"
+      "  -min_voxel_factor X    finest voxel = X fine steps at the median range; 0 = "
+      "automatic from the coarse scan (default 2)\n"
+      "  -progressive 0|1       1: each round a step finer, the last at the fine "
+      "step; 0: every round at the fine step (default 1)\n"
+      "  -window_steps X        evidence tiles of X coarse steps; 0 = "
+      "-roi_max_window_deg (default 2)\n"
+      "  -step_scale S          multiply every step by S (S > 1: a quicker, coarser "
+      "run; default 1)\n\n"
+      "The loop sets the regions' step (the fine step), point budget and yield; the "
+      "other\nregion options apply (the budget flags are ignored; -roi_margin_spacings "
+      "is 0.5 here):\n",
+      program);
+  selseg_apps::printRegionHelp();
+  print_info("Segmentation (both strategies):\n");
+  selseg_apps::printSegmentationHelp();
+}
+
+bool
+parseOptions(int argc, char** argv, Options& opt)
+{
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    const bool known =
+        a == "-out" || a == "-scenes" || a == "-iterations" || a == "-coarse_factor" ||
+        a == "-budget_fraction" || a == "-range_noise" || a == "-min_voxel_factor" ||
+        a == "-step_scale" || a == "-window_steps" || a == "-progressive" ||
+        std::find(selseg_apps::segmentationFlags().begin(),
+                  selseg_apps::segmentationFlags().end(),
+                  a) != selseg_apps::segmentationFlags().end() ||
+        std::find(selseg_apps::regionFlags().begin(),
+                  selseg_apps::regionFlags().end(),
+                  a) != selseg_apps::regionFlags().end();
+    if (!known || i + 1 >= argc) {
+      print_error("%s '%s' (see -h).\n",
+                  known ? "Missing value of" : "Unknown argument",
+                  a.c_str());
+      return false;
+    }
+    ++i;
+  }
+  parse_argument(argc, argv, "-out", opt.out);
+  if (opt.out.empty()) {
+    print_error("Give -out FOLDER.\n");
+    return false;
+  }
+  std::string scenes;
+  if (parse_argument(argc, argv, "-scenes", scenes) >= 0) {
+    opt.scenes.clear();
+    std::stringstream list(scenes);
+    std::string name;
+    while (std::getline(list, name, ',')) {
+      sim::PaperScene scene;
+      if (!sim::parsePaperScene(name, scene)) {
+        print_error("Unknown scene '%s': use cube, chair or door.\n", name.c_str());
+        return false;
+      }
+      opt.scenes.push_back(name);
+    }
+  }
+  using selseg_apps::parseNumber;
+  if (!parseNumber(argc, argv, "-iterations", opt.iterations) ||
+      !parseNumber(argc, argv, "-coarse_factor", opt.coarse_factor) ||
+      !parseNumber(argc, argv, "-budget_fraction", opt.budget_fraction) ||
+      !parseNumber(argc, argv, "-range_noise", opt.range_noise) ||
+      !parseNumber(argc, argv, "-min_voxel_factor", opt.min_voxel_factor) ||
+      !parseNumber(argc, argv, "-step_scale", opt.step_scale) ||
+      !parseNumber(argc, argv, "-window_steps", opt.window_steps) ||
+      !parseNumber(argc, argv, "-progressive", opt.progressive) ||
+      !selseg_apps::parseRegionOptions(argc, argv, opt.regions) ||
+      !selseg_apps::parseSegmentationOptions(argc, argv, opt.segmentation))
+    return false;
+  if (opt.segmentation.min_voxel_size > 0.0) {
+    print_error("-min_voxel_m does not apply here: the loop sets the voxel with "
+                "-min_voxel_factor, the uniform scans choose theirs.\n");
+    return false;
+  }
+  if (opt.iterations < 0 || opt.iterations > 100 || !(opt.coarse_factor >= 1.0) ||
+      !(opt.budget_fraction > 0.0 && opt.budget_fraction <= 1.0) ||
+      !(opt.range_noise >= 0.0 && opt.range_noise <= 1.0) ||
+      !(opt.min_voxel_factor >= 0.0) || !(opt.step_scale > 0.0) ||
+      !(opt.window_steps >= 0.0) ||
+      (opt.progressive != 0.0 && opt.progressive != 1.0)) {
+    print_error("Need 0 <= iterations <= 100, coarse_factor >= 1, 0 < budget_fraction "
+                "<= 1, 0 <= range_noise <= 1, min_voxel_factor >= 0, step_scale > 0, "
+                "window_steps >= 0, progressive 0 or 1.\n");
+    return false;
+  }
+  return true;
+}
+
+/** One row of a .dat file. */
+std::string
+datRow(const sim::ScanScore& s)
+{
+  std::ostringstream o;
+  o << std::setprecision(6) << s.points << " " << s.seconds << " " << s.accuracy.mean
+    << " " << s.accuracy.p90 << " " << s.spurious.mean << " "
+    << s.hoover.correct_detections << " " << s.hoover.over_segmentations << " "
+    << s.hoover.under_segmentations << " " << s.hoover.missed << " " << s.hoover.noise
+    << " " << s.under_segmentation << " " << s.segments << " " << s.windows << " "
+    << s.scanned_solid_angle;
+  return o.str();
+}
+
+/** One row of table.md. */
+std::string
+tableRow(const std::string& scene,
+         const std::string& strategy,
+         const sim::ScanScore& s,
+         std::size_t dense_points)
+{
+  char line[512];
+  std::snprintf(
+      line,
+      sizeof(line),
+      "| %s | %s | %zu | %.0f%% | %.3f | %.2f | %.2f | %.2f | %zu | %zu/%zu/%zu/"
+      "%zu/%zu | %.2f%% |\n",
+      scene.c_str(),
+      strategy.c_str(),
+      s.points,
+      100.0 * static_cast<double>(s.points) / static_cast<double>(dense_points),
+      s.seconds,
+      1000.0 * s.accuracy.mean,
+      1000.0 * s.accuracy.p90,
+      1000.0 * s.spurious.mean,
+      s.segments,
+      s.hoover.correct_detections,
+      s.hoover.over_segmentations,
+      s.hoover.under_segmentations,
+      s.hoover.missed,
+      s.hoover.noise,
+      100.0 * s.under_segmentation);
+  return line;
+}
+
+bool
+savePcd(const std::string& path, const pcl::PointCloud<pcl::PointXYZL>& cloud)
+{
+  try {
+    return pcl::io::savePCDFileBinary(path, cloud) == 0;
+  } catch (const pcl::IOException&) {
+    return false;
+  }
+}
+
+/** Run one scene; appends its rows to \a table. */
+bool
+runScene(const Options& opt, const std::string& name, std::string& table)
+{
+  sim::PaperScene which;
+  sim::parsePaperScene(name, which);
+  sim::SimulationSetup setup = sim::makePaperScene(which);
+  setup.sensor.range_noise = opt.range_noise;
+  const double fine = fineStep(name) * opt.step_scale;
+  const std::string base = opt.out + "/" + name;
+
+  sim::ReferenceBoundary reference;
+  if (!sim::makeReferenceBoundary(setup, 0.5 * fine, reference)) {
+    print_error("%s: the reference scan failed.\n", name.c_str());
+    return false;
+  }
+  print_info("%s: reference scan %zu points, %zu ground-truth boundary points\n",
+             name.c_str(),
+             reference.scan_points,
+             reference.points.size());
+
+  const pcl::selective_seg::SelectiveSegmentationParameters& seg_params =
+      opt.segmentation;
+  std::vector<sim::ScanScore> uniform;
+  const std::vector<double> factors = {3.0, 2.5, 2.0, 1.6, 1.3, 1.0};
+  for (const double f : factors) {
+    sim::ScanScore s;
+    pcl::PointCloud<pcl::PointXYZL> cloud;
+    if (!sim::runUniformScan(setup, f * fine, seg_params, reference, s, &cloud)) {
+      print_error("%s: the uniform scan at %g rad failed.\n", name.c_str(), f * fine);
+      return false;
+    }
+    uniform.push_back(s);
+    if (f == 1.0 && !savePcd(base + "_dense.pcd", cloud))
+      return false;
+  }
+  const std::size_t dense_points = uniform.back().points;
+
+  sim::SelectiveLoopParameters loop;
+  loop.fine_step = fine;
+  loop.coarse_factor = opt.coarse_factor;
+  loop.iterations = opt.iterations;
+  loop.min_voxel_factor = opt.min_voxel_factor;
+  loop.regions = opt.regions;
+  loop.segmentation = opt.segmentation;
+  loop.window_steps = opt.window_steps;
+  loop.progressive = opt.progressive == 1.0;
+  loop.point_budget =
+      static_cast<std::size_t>(opt.budget_fraction * static_cast<double>(dense_points));
+  std::vector<RegionOfInterest> scanned;
+  std::vector<sim::ScanScore> rounds;
+  bool files_ok = true;
+  double min_voxel = 0.0;
+  const auto observer = [&](const sim::LoopRound& r) {
+    min_voxel = r.result->min_voxel_size;
+    const auto& regions = *r.regions;
+    const auto& stats = r.region_stats;
+    if (r.iteration == 0) {
+      files_ok = files_ok && savePcd(base + "_coarse.pcd", *r.cloud) &&
+                 selseg_apps::writeRegionsJson(
+                     base + "_coarse_rois.json", name, loop.regions, stats, regions);
+    }
+    scanned.insert(scanned.end(), regions.begin(), regions.end());
+    if (regions.empty() || r.iteration == opt.iterations)
+      files_ok = files_ok && savePcd(base + "_refined.pcd", *r.cloud);
+    print_info("%s: round %d, %zu points, boundary accuracy %.2f mm; evidence "
+               "%zu/%zu/%zu vertices (transition/small/sparse), %zu candidate windows, "
+               "%zu already fine, %zu over budget, %zu chosen (%zu points estimated)\n",
+               name.c_str(),
+               r.iteration,
+               r.score.points,
+               1000.0 * r.score.accuracy.mean,
+               stats.transition_vertices,
+               stats.small_segment_vertices,
+               stats.sparse_vertices,
+               stats.candidates,
+               stats.already_fine,
+               stats.over_budget,
+               stats.selected,
+               stats.selected_points);
+  };
+  if (!sim::runSelectiveLoop(setup, loop, reference, rounds, observer)) {
+    print_error("%s: the selective loop failed.\n", name.c_str());
+    return false;
+  }
+  pcl::selective_seg::RegionOfInterestStats all;
+  all.selected = scanned.size();
+  files_ok = files_ok && selseg_apps::writeRegionsJson(
+                             base + "_windows.json", name, loop.regions, all, scanned);
+  // Where the error is: every reference boundary point with its distance to the
+  // nearest predicted boundary, for the finest uniform scan and the last round.
+  std::ofstream errors(base + "_boundary_errors.dat");
+  errors << "# theta phi (rad) distance_dense distance_selective (m)\n";
+  for (std::size_t i = 0; i < reference.points.size(); ++i) {
+    const auto& p = reference.points[i];
+    errors << std::atan2(p.x, p.z) << " " << std::atan2(p.y, p.z) << " "
+           << uniform.back().reference_distances[i] << " "
+           << rounds.back().reference_distances[i] << "\n";
+  }
+  errors.close();
+  files_ok = files_ok && static_cast<bool>(errors);
+  std::ofstream voxel(base + "_min_voxel.txt");
+  voxel << std::setprecision(9) << min_voxel << "\n";
+  std::ofstream dat(base + ".dat");
+  dat << "# " << name << ": fine step " << fine << " rad, coarse factor "
+      << opt.coarse_factor << ", budget " << loop.point_budget << " points\n"
+      << "# points seconds accuracy_mean_m accuracy_p90_m spurious_mean_m correct "
+         "over under missed noise under_seg_error segments windows solid_angle_sr\n"
+      << "# uniform\n";
+  for (const auto& s : uniform)
+    dat << datRow(s) << "\n";
+  dat << "\n\n# selective\n";
+  for (const auto& s : rounds)
+    dat << datRow(s) << "\n";
+  voxel.close();
+  dat.close();
+  if (!files_ok || !voxel || !dat) {
+    print_error(
+        "Cannot write the files of %s under '%s'.\n", name.c_str(), opt.out.c_str());
+    return false;
+  }
+  for (std::size_t i = 0; i < uniform.size(); ++i) {
+    char label[64];
+    std::snprintf(
+        label, sizeof(label), "uniform, step %.2f mrad", 1000.0 * factors[i] * fine);
+    table += tableRow(name, label, uniform[i], dense_points);
+  }
+  for (std::size_t i = 0; i < rounds.size(); ++i)
+    table += tableRow(name,
+                      i == 0 ? "selective, coarse scan"
+                             : "selective, round " + std::to_string(i),
+                      rounds[i],
+                      dense_points);
+  return true;
+}
+
+} // namespace
+
+int
+main(int argc, char** argv)
+{
+  if (argc < 2 || find_switch(argc, argv, "-h") || find_switch(argc, argv, "--help")) {
+    printHelp(argv[0]);
+    return argc < 2 ? kUsageError : 0;
+  }
+  Options opt;
+  // The loop's windows: half a spacing of margin (the default of one spacing is for a
+  // single finer look without follow-up rounds).
+  opt.regions.margin_spacings = 0.5;
+  if (!parseOptions(argc, argv, opt))
+    return kUsageError;
+  std::string table =
+      "| scene | strategy | points | of dense | time (s) | boundary accuracy, mean "
+      "(mm) "
+      "| p90 (mm) | spurious, mean (mm) | segments | correct/over/under/missed/noise "
+      "| under-seg. error |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const auto& scene : opt.scenes)
+    if (!runScene(opt, scene, table))
+      return kRuntimeError;
+  std::ofstream out(opt.out + "/table.md");
+  out << table;
+  out.close();
+  if (!out) {
+    print_error("Cannot write '%s/table.md'.\n", opt.out.c_str());
+    return kRuntimeError;
+  }
+  print_info("%s", table.c_str());
+  return 0;
+}

@@ -1,0 +1,84 @@
+#!/usr/bin/env bash
+# Regenerate the table, plots and pictures of docs/selective_sensing.md: the simulated
+# coarse-to-fine loop against uniform scans of the paper's three scenes.
+#
+# Usage: apps/run_selective_loop.sh BUILD_DIR [OUT_DIR] [IMAGES_DIR]
+#   OUT_DIR     table.md, <scene>.dat, clouds and windows (default: selective)
+#   IMAGES_DIR  the PNGs (default: docs/images beside this script); needs gnuplot,
+#               and xvfb-run for the viewer's pictures (skipped without it)
+set -euo pipefail
+here=$(cd "$(dirname "$0")" && pwd)
+build=${1:?usage: $0 BUILD_DIR [OUT_DIR] [IMAGES_DIR]}
+out=${2:-selective}
+images=${3:-$here/../docs/images}
+mkdir -p "$out" "$images"
+
+"$build/apps/pcl_selective_seg_selective_loop" -out "$out" | tee "$out/log.txt"
+
+# Boundary accuracy against points acquired, one panel per scene.
+gnuplot <<GNUPLOT
+set terminal pngcairo size 1500,480 font ",11"
+set output "$images/selective_accuracy.png"
+set multiplot layout 1,3 title "Boundary accuracy (mean distance from a true edge to the nearest segment boundary) against points acquired"
+set xlabel "points acquired (thousands)"
+set ylabel "boundary accuracy, mean [mm]"
+set grid
+set key top right
+do for [scene in "cube chair door"] {
+  file = "$out/".scene.".dat"
+  dense_points = system("awk '!/^#/ && NF {p=\$1} /^# selective/ {exit} END {print p}' ".file)
+  dense_acc = system("awk '!/^#/ && NF {a=\$3} /^# selective/ {exit} END {print a*1000}' ".file)
+  set title scene
+  set arrow 1 from dense_points*0.3/1000, graph 0 to dense_points*0.3/1000, graph 1 nohead dt 2 lc rgb "gray40"
+  set arrow 2 from graph 0, first dense_acc*1.1 to graph 1, first dense_acc*1.1 nohead dt 3 lc rgb "gray40"
+  plot file index 0 using (\$1/1000):(\$3*1000) with linespoints pt 7 lc rgb "#1f77b4" title "uniform scans", \
+       file index 1 using (\$1/1000):(\$3*1000) with linespoints pt 5 lc rgb "#d62728" title "selective: coarse, then rounds", \
+       NaN with lines dt 2 lc rgb "gray40" title "30% of the finest scan's points", \
+       NaN with lines dt 3 lc rgb "gray40" title "1.1 x its accuracy (the target)"
+}
+unset multiplot
+GNUPLOT
+
+# Where the error is on the cube: each true edge point coloured by its distance.
+gnuplot <<GNUPLOT
+set terminal pngcairo size 1200,560 font ",11"
+set output "$images/selective_cube_errors.png"
+set multiplot layout 1,2 title "cube: distance from each ground-truth boundary point to the nearest segment boundary [mm] (sensor angles)"
+set yrange [*:*] reverse
+set cbrange [0:30]
+set palette rgb 33,13,10
+set xlabel "theta [rad]"
+set ylabel "phi [rad]"
+set size ratio -1
+set title "uniform scan at the fine step (100% of its points)"
+plot "$out/cube_boundary_errors.dat" using 1:2:(\$3*1000) with points pt 7 ps 0.4 palette notitle
+set title "selective loop (coarse scan + 3 rounds)"
+plot "$out/cube_boundary_errors.dat" using 1:2:(\$4*1000) with points pt 7 ps 0.4 palette notitle
+unset multiplot
+GNUPLOT
+
+# The viewer's pictures: coarse result, the windows chosen on it, the refined result;
+# for the cube also every window scanned and the uniform scan at the fine step.
+if command -v xvfb-run > /dev/null; then
+  viewer="$build/apps/pcl_selective_seg_viewer"
+  shot() {
+    xvfb-run -a -s "-screen 0 1280x1024x24" "$viewer" "$@" -size 640x480 -no_legend \
+      > /dev/null
+  }
+  for scene in cube chair door; do
+    voxel=$(cat "$out/${scene}_min_voxel.txt")
+    shot "$out/${scene}_coarse.pcd" -min_voxel_m "$voxel" -view mesh \
+      -screenshot "$images/selective_${scene}_coarse.png"
+    shot "$out/${scene}_coarse.pcd" -min_voxel_m "$voxel" \
+      -roi_json "$out/${scene}_coarse_rois.json" \
+      -screenshot "$images/selective_${scene}_windows.png"
+    shot "$out/${scene}_refined.pcd" -min_voxel_m "$voxel" -view mesh \
+      -screenshot "$images/selective_${scene}_refined.png"
+  done
+  shot "$out/cube_refined.pcd" -min_voxel_m "$(cat "$out/cube_min_voxel.txt")" \
+    -roi_json "$out/cube_windows.json" -screenshot "$images/selective_cube_all_windows.png"
+  shot "$out/cube_dense.pcd" -screenshot "$images/selective_cube_dense.png"
+else
+  echo "xvfb-run not found: the viewer's pictures are not made" >&2
+fi
+echo "wrote $out/table.md and the pictures in $images"

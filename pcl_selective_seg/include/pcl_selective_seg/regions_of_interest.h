@@ -1,0 +1,215 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
+ */
+
+#pragma once
+
+#include <pcl_selective_seg/segmentation_result.h>
+#include <pcl_selective_seg/spherical_delaunay.h>
+
+#include <Eigen/Geometry>
+#include <pcl/pcl_macros.h>
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace pcl {
+namespace selective_seg {
+
+/** \brief Why a region of interest was proposed (bit flags of
+ * RegionOfInterest::reasons). */
+enum RegionReason : std::uint8_t {
+  /** Transition region: vertices of invalid edge triangles (eq. 8) or of finest-size
+   * octree leaves whose normals still spread more than the split threshold. */
+  kTransition = 1,
+  /** A segment with few points: a small object or a part the coarse scan resolves
+   * badly. */
+  kSmallSegment = 2,
+  /** Sparsely sampled area: vertices whose angular spacing is well above the scan's
+   * median; vertices of both other kinds that are sparse count as sparse only. */
+  kSparse = 4
+};
+
+/** \brief "transition", "small_segment", "sparse", joined by '+' for several. */
+PCL_EXPORTS std::string reasonsToString(std::uint8_t reasons);
+
+/** \brief Parameters of computeRegionsOfInterest(). Angles in radians. */
+struct PCL_EXPORTS RegionOfInterestParameters {
+  // --- what counts as evidence ---
+  /** \brief Invalid edge triangles are transition evidence. */
+  bool use_invalid_edges = true;
+  /** \brief Valid edge triangles (segment borders the surface continues across) are
+   * transition evidence too (with use_invalid_edges). */
+  bool use_valid_edges = false;
+  /** \brief Finest-size octree leaves (the smallest leaf size of the result) whose
+   * sigma_theta or sigma_phi exceeds this are transition evidence [rad]; the
+   * segmentation's split threshold (max_normal_std_dev, 7.6 deg by default) is the
+   * natural value. 0 or less: leaves are not used. Valid: finite. */
+  double leaf_sigma_threshold = 7.6 * M_PI / 180.0;
+  /** \brief Segments with fewer points than this are small-segment evidence; 0: off.
+   */
+  std::size_t small_segment_points = 30;
+  /** \brief Vertices whose angular spacing exceeds this many times the median vertex
+   * spacing of the scan are sparse evidence; 0: off. Valid: 0 or >= 1. */
+  double sparse_factor = 2.0;
+
+  /** \brief Evidence of one kind in mesh-connected groups of fewer vertices is
+   * ignored (isolated noise). Valid: >= 1. */
+  std::size_t min_component_vertices = 3;
+
+  // --- windows ---
+  /** \brief Evidence is split into tiles of at most this size in each angle before
+   * windows are made (a long diagonal edge becomes a staircase of small windows rather
+   * than one large one); merged windows never exceed it either [rad].
+   * Valid: (0, pi]. */
+  double max_window_size = 0.05;
+  /** \brief Windows smaller than this in an angle are widened to it, about their
+   * centre [rad]. Valid: [0, max_window_size]. */
+  double min_window_size = 0.0;
+  /** \brief Margin added around the evidence [rad], besides margin_spacings.
+   * Valid: >= 0, finite. */
+  double margin = 0.0;
+  /** \brief Margin added around the evidence in units of its current angular spacing
+   * (the true edge lies anywhere between the coarse samples). Valid: >= 0, finite. */
+  double margin_spacings = 1.0;
+  /** \brief Two overlapping (or edge-sharing) windows merge when their bounding window
+   * is at most this many times the area they cover together (and fits max_window_size):
+   * overlaps are removed where that wastes little. Valid: >= 1, finite. */
+  double merge_area_ratio = 1.25;
+
+  // --- sampling ---
+  /** \brief Suggested angular step of the finer scan [rad]; 0: each window's current
+   * spacing divided by refinement_factor. Valid: >= 0, finite. */
+  double target_step = 0.0;
+  /** \brief Refinement of the step when target_step is 0. Valid: > 1, finite. */
+  double refinement_factor = 3.0;
+  /** \brief Windows whose current spacing is below this many times the suggested step
+   * are already fine enough and dropped; with a target_step, so is every evidence
+   * vertex whose own spacing is below this many target steps (a region already
+   * scanned finely proposes no window). Valid: >= 1, finite. */
+  double min_refinement = 1.5;
+
+  // --- priority ---
+  /** \brief Weight of transition evidence from invalid edge triangles, >= 0. */
+  double transition_weight = 1.0;
+  /** \brief Weight of transition evidence from finest octree leaves only, >= 0. */
+  double leaf_weight = 0.7;
+  /** \brief Weight of transition evidence from valid edge triangles only, >= 0. */
+  double valid_edge_weight = 0.5;
+  double small_segment_weight = 0.6; ///< weight of small-segment evidence, >= 0
+  double sparse_weight = 0.3;        ///< weight of sparse evidence, >= 0
+
+  // --- budget (0 = no limit) ---
+  /** \brief Largest total solid angle of the selected windows [sr]. Valid: >= 0. */
+  double max_solid_angle = 0.0;
+  /** \brief Largest total of estimated_points of the selected windows. */
+  std::size_t max_points = 0;
+  /** \brief Largest number of selected windows. */
+  std::size_t max_regions = 0;
+  /** \brief Density model: the fraction of the rays of a scan at the suggested step
+   * that returns a point (texture, dropouts, misses). Valid: (0, 1]. */
+  double sample_yield = 1.0;
+
+  /** \brief Check every parameter.
+   * \param[out] why when invalid and non-null: the parameter, its value and its
+   *             valid range.
+   * \return true when all parameters are valid. */
+  bool validate(std::string* why = nullptr) const;
+};
+
+/** \brief A region of the view worth a finer acquisition. */
+struct RegionOfInterest {
+  /** Angular window in the sensor frame, eq. 1's angles theta = atan2(x, z),
+   * phi = atan2(y, z) [rad]. */
+  double theta_min = 0.0;
+  double theta_max = 0.0;
+  double phi_min = 0.0;
+  double phi_max = 0.0;
+  /** Axis-aligned box, in the cloud frame, of the points of the segmented scan whose
+   * angles lie in the window [m] (empty box, min > max, when none does). */
+  Eigen::Vector3f box_min = Eigen::Vector3f::Zero();
+  Eigen::Vector3f box_max = Eigen::Vector3f::Zero();
+  /** The weighted share of the window's area that its evidence stands for (each
+   * evidence vertex for its spacing squared: sum of weight x spacing^2 over
+   * max(window area, sum of spacing^2)) times the share of new samples a scan at the
+   * suggested step brings, 1 - suggested_step / current_step; in [0, largest
+   * weight]. */
+  double priority = 0.0;
+  double suggested_step = 0.0;  ///< angular step of the finer scan [rad]
+  double current_step = 0.0;    ///< median angular spacing of its evidence now [rad]
+  std::uint8_t reasons = 0;     ///< RegionReason bits
+  std::size_t num_evidence = 0; ///< evidence vertices inside
+  std::size_t num_points = 0;   ///< mesh vertices of the scan inside the window
+  std::size_t estimated_points = 0; ///< sample_yield x window area / step^2
+  double solid_angle = 0.0;         ///< of the window [sr]
+};
+
+/** \brief What computeRegionsOfInterest() found. */
+struct RegionOfInterestStats {
+  std::size_t transition_vertices = 0;
+  std::size_t small_segment_vertices = 0;
+  std::size_t sparse_vertices = 0;
+  std::size_t candidates = 0;        ///< windows after merging
+  std::size_t already_fine = 0;      ///< candidates dropped by min_refinement
+  std::size_t over_budget = 0;       ///< candidates left out by the budget
+  std::size_t selected = 0;          ///< windows returned
+  double selected_solid_angle = 0.0; ///< [sr]
+  std::size_t selected_points = 0;   ///< sum of estimated_points
+};
+
+/** \brief Solid angle of an angular window of eq. 1's angles [sr] (exact: the window
+ * is a rectangle on the plane z = 1). */
+PCL_EXPORTS double
+windowSolidAngle(double theta_min, double theta_max, double phi_min, double phi_max);
+
+/** \brief Regions of interest of a segmentation for a finer acquisition.
+ *
+ * Evidence vertices (RegionReason) are grouped by kind into mesh-connected components,
+ * each component is cut into tiles of max_window_size from its smallest angles, each
+ * tile gives a window (its vertices' angles plus margins), overlapping windows merge
+ * (merge_area_ratio), windows already sampled at about the suggested step are dropped,
+ * and the budget picks windows greedily by priority. Output order: priority
+ * decreasing, then theta_min, phi_min, theta_max, phi_max increasing. The result
+ * depends on the segmentation only.
+ *
+ * \param[in] result the segmentation (labels, mesh classes, leaves)
+ * \param[in] triangulation its triangulation
+ * (SelectiveSegmentation::getTriangulation()) \param[in] sensor_to_cloud the sensor
+ * pose used by the segmentation \param[in] params the parameters \param[out] regions
+ * the selected windows; empty on failure \param[out] stats if non-null: counts of
+ * evidence and windows \return false (with PCL_ERROR saying why) on invalid parameters
+ * or a result that does not belong to the triangulation. An empty scan gives no region.
+ */
+PCL_EXPORTS bool computeRegionsOfInterest(const SegmentationResult& result,
+                                          const SphericalTriangulation& triangulation,
+                                          const Eigen::Affine3f& sensor_to_cloud,
+                                          const RegionOfInterestParameters& params,
+                                          std::vector<RegionOfInterest>& regions,
+                                          RegionOfInterestStats* stats = nullptr);
+
+/** \brief The same for a SelectiveSegmentation after a successful extract() or
+ * update(), with the sensor pose of its input cloud (sensor_origin_ /
+ * sensor_orientation_); pass the pose when setSensorPose() overrode it. */
+template <typename Segmentation>
+bool
+computeRegionsOfInterest(const Segmentation& seg,
+                         const RegionOfInterestParameters& params,
+                         std::vector<RegionOfInterest>& regions,
+                         RegionOfInterestStats* stats = nullptr)
+{
+  Eigen::Affine3f pose = Eigen::Affine3f::Identity();
+  if (const auto cloud = seg.getInputCloud()) {
+    pose.translation() = cloud->sensor_origin_.template head<3>();
+    pose.linear() = cloud->sensor_orientation_.normalized().toRotationMatrix();
+  }
+  return computeRegionsOfInterest(
+      seg.getResult(), seg.getTriangulation(), pose, params, regions, stats);
+}
+
+} // namespace selective_seg
+} // namespace pcl

@@ -1,0 +1,143 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
+ */
+
+#pragma once
+
+#include <pcl_selective_seg/parameters.h>
+#include <pcl_selective_seg/regions_of_interest.h>
+#include <pcl_selective_seg/segmentation_metrics.h>
+#include <pcl_selective_seg/sensor_simulator.h>
+
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace pcl {
+namespace selective_seg {
+namespace simulation {
+
+/** \brief Ground-truth boundary points of a scene for boundary accuracy: the boundary
+ * points (metrics::labelBoundaryPoints()) of the ground-truth labels over the
+ * spherical Delaunay mesh of a very dense, noise-free scan. */
+struct PCL_EXPORTS ReferenceBoundary {
+  pcl::PointCloud<pcl::PointXYZ> points; ///< the boundary points [m]
+  std::size_t scan_points = 0;           ///< points of the reference scan
+  double step = 0.0;                     ///< its angular step [rad]
+};
+
+/** \brief Scan the sensor's view window at \a step without range noise and extract the
+ * ground-truth boundary points; mesh edges longer than 4 steps (across holes) are left
+ * out.
+ * \return false (with PCL_ERROR) when the scan or the triangulation fails. */
+PCL_EXPORTS bool makeReferenceBoundary(const SimulationSetup& setup,
+                                       double step,
+                                       ReferenceBoundary& reference);
+
+/** \brief The scores of one segmented scan against the ground truth. */
+struct PCL_EXPORTS ScanScore {
+  std::size_t points = 0;         ///< points acquired so far
+  std::size_t windows = 0;        ///< windows scanned in this step
+  double scanned_solid_angle = 0; ///< solid angle scanned so far, overlaps counted [sr]
+  double seconds = 0.0; ///< computing time so far: segmentation, update, ROI [s]
+  std::size_t segments = 0;
+  /** Ground-truth boundary points to the nearest predicted boundary point: boundary
+   * accuracy (mean, median, p90). */
+  metrics::BoundaryDistances accuracy;
+  /** The distance of every reference boundary point [m] (ReferenceBoundary order). */
+  std::vector<float> reference_distances;
+  /** Predicted boundary points to the nearest ground-truth boundary point (spurious
+   * boundaries). */
+  metrics::BoundaryDistances spurious;
+  metrics::HooverScores hoover;    ///< at T = 0.8
+  double under_segmentation = 0.0; ///< metrics::underSegmentationError
+};
+
+/** \brief Score a segmentation of a labeled scan: \a labels and \a triangles (over
+ * point indices) from SegmentationResult, ground truth from the cloud's labels.
+ * \param[in] max_edge_angle predicted boundary edges subtending more are left out
+ *            [rad] */
+PCL_EXPORTS bool scoreSegmentation(const pcl::PointCloud<pcl::PointXYZL>& cloud,
+                                   const SegmentationResult& result,
+                                   const ReferenceBoundary& reference,
+                                   double max_edge_angle,
+                                   ScanScore& score);
+
+/** \brief Parameters of the simulated coarse-to-fine loop. */
+struct PCL_EXPORTS SelectiveLoopParameters {
+  /** \brief Angular step of the finest scans: the target step of the last round's
+   * regions of interest [rad], > 0. */
+  double fine_step = 0.004;
+  /** \brief The coarse scan's step is this many times fine_step, >= 1. */
+  double coarse_factor = 3.0;
+  /** \brief Refinement rounds (ROI, scan, update), >= 0. */
+  int iterations = 3;
+  /** \brief Each round a step finer: round r of n targets coarse_step x (fine_step /
+   * coarse_step)^(r / n), the last fine_step (a round confirms and narrows the
+   * transitions the previous one found). false: every round targets fine_step. */
+  bool progressive = true;
+  /** \brief Points the whole loop may acquire, the coarse scan included, > 0; each
+   * round may use the remaining budget divided by the remaining rounds. */
+  std::size_t point_budget = 10000;
+  /** \brief Finest octree voxel: this many times fine_step times the coarse scan's
+   * median range [m] (the automatic size of a scan at fine_step); 0: the automatic
+   * size of the coarse scan, which update() then keeps. */
+  double min_voxel_factor = 2.0;
+  /** \brief Predicted boundary edges longer than this many coarse steps are left out
+   * of boundary accuracy (edges across holes). */
+  double boundary_edge_steps = 4.0;
+  /** \brief Evidence tiles (RegionOfInterestParameters::max_window_size) of this
+   * many coarse steps; 0: keep regions.max_window_size. */
+  double window_steps = 2.0;
+  SelectiveSegmentationParameters segmentation;
+  /** \brief The regions of interest; target_step, max_points and sample_yield are set
+   * by the loop (the yield from the coarse scan, then corrected each round by the
+   * points a round's windows actually returned over their estimate). */
+  RegionOfInterestParameters regions;
+};
+
+/** \brief One round of the loop, as reported to the observer. */
+struct LoopRound {
+  int iteration = 0;                                      ///< 0 = the coarse scan
+  const pcl::PointCloud<pcl::PointXYZL>* cloud = nullptr; ///< everything acquired
+  const SegmentationResult* result = nullptr;             ///< its segmentation
+  /** The windows chosen after this round and scanned for the next one (those of
+   * computeRegionsOfInterest() that the points acquired so far left room for). */
+  const std::vector<RegionOfInterest>* regions = nullptr;
+  RegionOfInterestStats region_stats; ///< of computeRegionsOfInterest() this round
+  ScanScore score;
+};
+
+/** \brief Coarse scan, segment, regions of interest under the point budget, finer scans
+ * of them, SelectiveSegmentation::update(), repeated.
+ * \param[in] setup the scene and sensor (view window, noise, seed)
+ * \param[in] params the loop
+ * \param[in] reference ground-truth boundaries (makeReferenceBoundary())
+ * \param[out] rounds one score per round, the coarse scan first
+ * \param[in] observer if set, called after every round (pictures, files)
+ * \return false (with PCL_ERROR) on invalid parameters or a failed stage. */
+PCL_EXPORTS bool
+runSelectiveLoop(const SimulationSetup& setup,
+                 const SelectiveLoopParameters& params,
+                 const ReferenceBoundary& reference,
+                 std::vector<ScanScore>& rounds,
+                 const std::function<void(const LoopRound&)>& observer = {});
+
+/** \brief A uniform scan of the whole view window at \a step, segmented and scored
+ * (boundary edges up to 4 steps).
+ * \param[out] cloud if non-null: the scan */
+PCL_EXPORTS bool runUniformScan(const SimulationSetup& setup,
+                                double step,
+                                const SelectiveSegmentationParameters& segmentation,
+                                const ReferenceBoundary& reference,
+                                ScanScore& score,
+                                pcl::PointCloud<pcl::PointXYZL>* cloud = nullptr);
+
+} // namespace simulation
+} // namespace selective_seg
+} // namespace pcl

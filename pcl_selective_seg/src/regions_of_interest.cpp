@@ -1,0 +1,669 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
+ */
+
+#include <pcl_selective_seg/regions_of_interest.h>
+
+#include <pcl/console/print.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <sstream>
+#include <tuple>
+
+namespace pcl {
+namespace selective_seg {
+
+namespace {
+
+constexpr double kHalfPi = 0.5 * M_PI;
+/** Windows stay this far inside (-pi/2, pi/2), where eq. 1 has an image. */
+constexpr double kEdgeGuard = 1e-6;
+
+bool
+reject(std::string* why, const char* name, double value, const char* range)
+{
+  if (why) {
+    std::ostringstream s;
+    s << "parameter " << name << " = " << value << " is invalid: valid range " << range;
+    *why = s.str();
+  }
+  return false;
+}
+
+bool
+finiteAtLeast(double value, double lo)
+{
+  return std::isfinite(value) && value >= lo;
+}
+
+/** Union-find over vertices, with path halving; the root is the smallest member. */
+class DisjointSets {
+public:
+  explicit DisjointSets(std::size_t n)
+      : parent_(n)
+  {
+    std::iota(parent_.begin(), parent_.end(), 0);
+  }
+  std::size_t find(std::size_t x)
+  {
+    while (parent_[x] != x) {
+      parent_[x] = parent_[parent_[x]];
+      x = parent_[x];
+    }
+    return x;
+  }
+  void unite(std::size_t a, std::size_t b)
+  {
+    a = find(a);
+    b = find(b);
+    if (a != b)
+      parent_[std::max(a, b)] = std::min(a, b);
+  }
+
+private:
+  std::vector<std::size_t> parent_;
+};
+
+/** A window under construction. */
+struct Window {
+  double theta_min, theta_max, phi_min, phi_max;
+  std::uint8_t reasons = 0;
+  std::vector<pcl::index_t> evidence; ///< vertex ids
+  double width() const { return theta_max - theta_min; }
+  double height() const { return phi_max - phi_min; }
+  double area() const { return width() * height(); }
+};
+
+double
+overlapArea(const Window& a, const Window& b)
+{
+  const double w =
+      std::min(a.theta_max, b.theta_max) - std::max(a.theta_min, b.theta_min);
+  const double h = std::min(a.phi_max, b.phi_max) - std::max(a.phi_min, b.phi_min);
+  return w > 0.0 && h > 0.0 ? w * h : 0.0;
+}
+
+/** Whether two windows overlap or share a stretch of their borders. */
+bool
+meet(const Window& a, const Window& b)
+{
+  const double w =
+      std::min(a.theta_max, b.theta_max) - std::max(a.theta_min, b.theta_min);
+  const double h = std::min(a.phi_max, b.phi_max) - std::max(a.phi_min, b.phi_min);
+  return w >= 0.0 && h >= 0.0 && (w > 0.0 || h > 0.0);
+}
+
+Window
+boundingWindow(const Window& a, const Window& b)
+{
+  Window u;
+  u.theta_min = std::min(a.theta_min, b.theta_min);
+  u.theta_max = std::max(a.theta_max, b.theta_max);
+  u.phi_min = std::min(a.phi_min, b.phi_min);
+  u.phi_max = std::max(a.phi_max, b.phi_max);
+  return u;
+}
+
+double
+median(std::vector<double> v)
+{
+  if (v.empty())
+    return 0.0;
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+/** Median angular length of the mesh edges at each vertex [rad] (0 when isolated). */
+std::vector<double>
+vertexSpacing(const SphericalTriangulation& tri,
+              const std::vector<Eigen::Vector2d>& angles)
+{
+  const std::size_t nv = angles.size();
+  std::vector<std::size_t> start(nv + 1, 0);
+  for (const auto& t : tri.triangles)
+    for (const auto v : t)
+      start[v + 1] += 2;
+  std::partial_sum(start.begin(), start.end(), start.begin());
+  std::vector<double> lengths(start.back());
+  std::vector<std::size_t> fill(start.begin(), start.end() - 1);
+  for (const auto& t : tri.triangles)
+    for (int k = 0; k < 3; ++k) {
+      const auto a = t[k];
+      const auto b = t[(k + 1) % 3];
+      const double length = (angles[a] - angles[b]).norm();
+      lengths[fill[a]++] = length;
+      lengths[fill[b]++] = length;
+    }
+  std::vector<double> spacing(nv, 0.0);
+  for (std::size_t v = 0; v < nv; ++v) {
+    const auto first = lengths.begin() + static_cast<std::ptrdiff_t>(start[v]);
+    const auto last = lengths.begin() + static_cast<std::ptrdiff_t>(start[v + 1]);
+    if (first == last)
+      continue;
+    const auto mid = first + (last - first) / 2;
+    std::nth_element(first, mid, last);
+    spacing[v] = *mid;
+  }
+  return spacing;
+}
+
+/** Integer key of the finest-size octree cell holding a sensor-frame position. */
+using CellKey = std::array<std::int64_t, 3>;
+
+CellKey
+cellKey(const Eigen::Vector3d& position, const Eigen::Vector3d& origin, double size)
+{
+  const Eigen::Vector3d c = (position - origin) / size;
+  return {static_cast<std::int64_t>(std::floor(c.x() + 0.5)),
+          static_cast<std::int64_t>(std::floor(c.y() + 0.5)),
+          static_cast<std::int64_t>(std::floor(c.z() + 0.5))};
+}
+
+/** Vertices inside finest-size leaves whose normals spread above the threshold. */
+void
+markLeafEvidence(const SegmentationResult& result,
+                 const SphericalTriangulation& tri,
+                 const Eigen::Affine3d& cloud_to_sensor,
+                 double sigma_threshold,
+                 std::vector<std::uint8_t>& kinds)
+{
+  if (!(sigma_threshold > 0.0) || result.leaves.empty())
+    return;
+  float finest = std::numeric_limits<float>::infinity();
+  for (const auto& leaf : result.leaves)
+    if (leaf.size > 0.0f)
+      finest = std::min(finest, leaf.size);
+  if (!std::isfinite(finest))
+    return;
+  const double size = finest;
+  bool have_origin = false;
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+  std::vector<CellKey> cells;
+  for (const auto& leaf : result.leaves) {
+    if (!(leaf.size <= finest * (1.0f + 1e-4f)) ||
+        !(std::max(leaf.sigma_theta, leaf.sigma_phi) > sigma_threshold))
+      continue;
+    const Eigen::Vector3d centre = cloud_to_sensor * leaf.centre.cast<double>();
+    if (!have_origin) {
+      origin = centre;
+      have_origin = true;
+    }
+    cells.push_back(cellKey(centre, origin, size));
+  }
+  if (cells.empty())
+    return;
+  std::sort(cells.begin(), cells.end());
+  for (std::size_t v = 0; v < tri.vertex_positions.size(); ++v)
+    if (std::binary_search(
+            cells.begin(),
+            cells.end(),
+            cellKey(tri.vertex_positions[v].cast<double>(), origin, size)))
+      kinds[v] |= kTransition;
+}
+
+/** Evidence bits of every vertex. */
+std::vector<std::uint8_t>
+findEvidence(const SegmentationResult& result,
+             const SphericalTriangulation& tri,
+             const Eigen::Affine3d& cloud_to_sensor,
+             const std::vector<Eigen::Vector2d>& angles,
+             const std::vector<double>& spacing,
+             const RegionOfInterestParameters& p,
+             std::vector<double>& transition_strength)
+{
+  const std::size_t nv = tri.vertex_point.size();
+  std::vector<std::uint8_t> kinds(nv, 0);
+  // The strength of transition evidence: invalid edges, then leaves, then valid edges.
+  transition_strength.assign(nv, 0.0);
+  const auto mark = [&](std::size_t v, double weight) {
+    kinds[v] |= kTransition;
+    transition_strength[v] = std::max(transition_strength[v], weight);
+  };
+  for (std::size_t t = 0; t < tri.triangles.size(); ++t) {
+    const auto c = result.mesh.classes[t];
+    if (p.use_invalid_edges && c == TriangleClass::InvalidEdge)
+      for (const auto v : tri.triangles[t])
+        mark(static_cast<std::size_t>(v), p.transition_weight);
+    else if (p.use_valid_edges && c == TriangleClass::ValidEdge)
+      for (const auto v : tri.triangles[t])
+        mark(static_cast<std::size_t>(v), p.valid_edge_weight);
+  }
+  std::vector<std::uint8_t> leaf(nv, 0);
+  markLeafEvidence(result, tri, cloud_to_sensor, p.leaf_sigma_threshold, leaf);
+  for (std::size_t v = 0; v < nv; ++v)
+    if (leaf[v])
+      mark(v, p.leaf_weight);
+  if (p.small_segment_points > 0)
+    for (std::size_t v = 0; v < nv; ++v) {
+      const std::uint32_t label = result.labels[tri.vertex_point[v]];
+      if (label > 0 && label <= result.segments.size() &&
+          result.segments[label - 1].num_points < p.small_segment_points)
+        kinds[v] |= kSmallSegment;
+    }
+  if (p.sparse_factor > 0.0) {
+    std::vector<double> positive;
+    for (const double s : spacing)
+      if (s > 0.0)
+        positive.push_back(s);
+    const double typical = median(positive);
+    // An invalid edge triangle among sparse samples says "too coarse" rather than
+    // "an edge" (holes are spanned by such triangles): such vertices are sparse only.
+    for (std::size_t v = 0; v < nv; ++v)
+      if (typical > 0.0 && spacing[v] > p.sparse_factor * typical)
+        kinds[v] = kSparse;
+  }
+  // The mesh's outer boundary is the edge of the view, not a transition: its long,
+  // thin hull triangles look like invalid edges and sparse samples. The end points of
+  // a boundary edge longer than twice their own spacing are no evidence.
+  for (std::size_t t = 0; t < tri.triangles.size(); ++t)
+    for (int k = 0; k < 3; ++k) {
+      if (tri.neighbours[t][k] >= 0)
+        continue;
+      const auto a = tri.triangles[t][(k + 1) % 3];
+      const auto b = tri.triangles[t][(k + 2) % 3];
+      if ((angles[a] - angles[b]).norm() > 2.0 * std::max(spacing[a], spacing[b]))
+        kinds[a] = kinds[b] = 0;
+    }
+  // With a fixed target step, evidence already sampled about that finely is spent:
+  // windows grow around coarse evidence only.
+  if (p.target_step > 0.0)
+    for (std::size_t v = 0; v < nv; ++v)
+      if (kinds[v] && spacing[v] < p.min_refinement * p.target_step)
+        kinds[v] = 0;
+  return kinds;
+}
+
+/** One window per (kind, mesh-connected component, tile of max_window_size). */
+std::vector<Window>
+makeTileWindows(const SphericalTriangulation& tri,
+                const std::vector<Eigen::Vector2d>& angles,
+                const std::vector<std::uint8_t>& kinds,
+                const std::vector<double>& spacing,
+                const RegionOfInterestParameters& p)
+{
+  const std::size_t nv = angles.size();
+  // (kind, component, tile theta, tile phi, vertex): sorted, groups are windows.
+  using Entry = std::tuple<int, std::size_t, std::int64_t, std::int64_t, pcl::index_t>;
+  std::vector<Entry> entries;
+  for (const std::uint8_t kind : {kTransition, kSmallSegment, kSparse}) {
+    DisjointSets sets(nv);
+    for (const auto& t : tri.triangles)
+      for (int k = 0; k < 3; ++k) {
+        const auto a = t[k];
+        const auto b = t[(k + 1) % 3];
+        if ((kinds[a] & kind) && (kinds[b] & kind))
+          sets.unite(static_cast<std::size_t>(a), static_cast<std::size_t>(b));
+      }
+    // Tiles start at the component's smallest angles: a component that fits in one
+    // tile gives one window.
+    std::vector<std::size_t> size(nv, 0);
+    std::vector<Eigen::Vector2d> start(nv, Eigen::Vector2d::Constant(kHalfPi));
+    for (std::size_t v = 0; v < nv; ++v)
+      if (kinds[v] & kind) {
+        const std::size_t root = sets.find(v);
+        ++size[root];
+        start[root] = start[root].cwiseMin(angles[v]);
+      }
+    for (std::size_t v = 0; v < nv; ++v) {
+      const std::size_t root = sets.find(v);
+      if (!(kinds[v] & kind) || size[root] < p.min_component_vertices)
+        continue;
+      const Eigen::Vector2d tile = (angles[v] - start[root]) / p.max_window_size;
+      entries.emplace_back(kind,
+                           root,
+                           static_cast<std::int64_t>(std::floor(tile.x())),
+                           static_cast<std::int64_t>(std::floor(tile.y())),
+                           static_cast<pcl::index_t>(v));
+    }
+  }
+  std::sort(entries.begin(), entries.end());
+  std::vector<Window> windows;
+  for (std::size_t i = 0; i < entries.size();) {
+    std::size_t j = i;
+    Window w;
+    w.theta_min = w.phi_min = std::numeric_limits<double>::infinity();
+    w.theta_max = w.phi_max = -std::numeric_limits<double>::infinity();
+    w.reasons = static_cast<std::uint8_t>(std::get<0>(entries[i]));
+    std::vector<double> local;
+    for (; j < entries.size() && std::get<0>(entries[j]) == std::get<0>(entries[i]) &&
+           std::get<1>(entries[j]) == std::get<1>(entries[i]) &&
+           std::get<2>(entries[j]) == std::get<2>(entries[i]) &&
+           std::get<3>(entries[j]) == std::get<3>(entries[i]);
+         ++j) {
+      const auto v = std::get<4>(entries[j]);
+      w.theta_min = std::min(w.theta_min, angles[v].x());
+      w.theta_max = std::max(w.theta_max, angles[v].x());
+      w.phi_min = std::min(w.phi_min, angles[v].y());
+      w.phi_max = std::max(w.phi_max, angles[v].y());
+      w.evidence.push_back(v);
+      local.push_back(spacing[v]);
+    }
+    const double margin = p.margin + p.margin_spacings * median(local);
+    const double grow_theta = std::max(margin, 0.5 * (p.min_window_size - w.width()));
+    const double grow_phi = std::max(margin, 0.5 * (p.min_window_size - w.height()));
+    w.theta_min = std::max(w.theta_min - grow_theta, -kHalfPi + kEdgeGuard);
+    w.theta_max = std::min(w.theta_max + grow_theta, kHalfPi - kEdgeGuard);
+    w.phi_min = std::max(w.phi_min - grow_phi, -kHalfPi + kEdgeGuard);
+    w.phi_max = std::min(w.phi_max + grow_phi, kHalfPi - kEdgeGuard);
+    if (w.width() > 0.0 && w.height() > 0.0)
+      windows.push_back(std::move(w));
+    i = j;
+  }
+  return windows;
+}
+
+bool
+windowLess(const Window& a, const Window& b)
+{
+  return std::tie(a.theta_min, a.phi_min, a.theta_max, a.phi_max) <
+         std::tie(b.theta_min, b.phi_min, b.theta_max, b.phi_max);
+}
+
+/** Whether b merges into a: they meet, their bounding window fits the tile size and
+ * wastes little area. */
+bool
+mergeable(const Window& a, const Window& b, const RegionOfInterestParameters& p)
+{
+  if (!meet(a, b))
+    return false;
+  const Window u = boundingWindow(a, b);
+  return u.width() <= std::max({p.max_window_size, a.width(), b.width()}) &&
+         u.height() <= std::max({p.max_window_size, a.height(), b.height()}) &&
+         u.area() <= p.merge_area_ratio * (a.area() + b.area() - overlapArea(a, b));
+}
+
+/** Merge overlapping windows while the bounding window wastes little area. A sweep in
+ * theta: window i is compared only with the later windows whose theta range starts
+ * inside its own; passes repeat until nothing merges. */
+void
+mergeWindows(std::vector<Window>& windows, const RegionOfInterestParameters& p)
+{
+  bool changed = true;
+  while (changed) {
+    changed = false;
+    std::sort(windows.begin(), windows.end(), windowLess);
+    std::vector<char> alive(windows.size(), 1);
+    for (std::size_t i = 0; i < windows.size(); ++i) {
+      if (!alive[i])
+        continue;
+      for (bool grew = true; grew;) {
+        grew = false;
+        for (std::size_t j = i + 1;
+             j < windows.size() && windows[j].theta_min <= windows[i].theta_max;
+             ++j) {
+          if (!alive[j] || !mergeable(windows[i], windows[j], p))
+            continue;
+          Window& a = windows[i];
+          Window& b = windows[j];
+          Window u = boundingWindow(a, b);
+          u.reasons = a.reasons | b.reasons;
+          u.evidence = std::move(a.evidence);
+          u.evidence.insert(u.evidence.end(), b.evidence.begin(), b.evidence.end());
+          b.evidence.clear();
+          a = std::move(u);
+          alive[j] = 0;
+          changed = grew = true;
+        }
+      }
+    }
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < windows.size(); ++i)
+      if (alive[i]) {
+        if (kept != i)
+          windows[kept] = std::move(windows[i]);
+        ++kept;
+      }
+    windows.resize(kept);
+  }
+}
+
+double
+kindWeight(std::uint8_t kinds,
+           double transition_strength,
+           const RegionOfInterestParameters& p)
+{
+  double w = 0.0;
+  if (kinds & kTransition)
+    w = std::max(w, transition_strength);
+  if (kinds & kSmallSegment)
+    w = std::max(w, p.small_segment_weight);
+  if (kinds & kSparse)
+    w = std::max(w, p.sparse_weight);
+  return w;
+}
+
+} // namespace
+
+std::string
+reasonsToString(std::uint8_t reasons)
+{
+  std::string s;
+  const auto add = [&](std::uint8_t bit, const char* name) {
+    if (reasons & bit)
+      s += (s.empty() ? "" : "+") + std::string(name);
+  };
+  add(kTransition, "transition");
+  add(kSmallSegment, "small_segment");
+  add(kSparse, "sparse");
+  return s;
+}
+
+bool
+RegionOfInterestParameters::validate(std::string* why) const
+{
+  if (!std::isfinite(leaf_sigma_threshold))
+    return reject(why, "leaf_sigma_threshold", leaf_sigma_threshold, "finite [rad]");
+  if (!(sparse_factor == 0.0 || finiteAtLeast(sparse_factor, 1.0)))
+    return reject(why, "sparse_factor", sparse_factor, "0 or [1, inf)");
+  if (min_component_vertices < 1)
+    return reject(why, "min_component_vertices", 0.0, "[1, inf)");
+  if (!(max_window_size > 0.0 && max_window_size <= M_PI))
+    return reject(why, "max_window_size", max_window_size, "(0, pi] [rad]");
+  if (!(min_window_size >= 0.0 && min_window_size <= max_window_size))
+    return reject(
+        why, "min_window_size", min_window_size, "[0, max_window_size] [rad]");
+  if (!finiteAtLeast(margin, 0.0))
+    return reject(why, "margin", margin, "[0, inf) [rad]");
+  if (!finiteAtLeast(margin_spacings, 0.0))
+    return reject(why, "margin_spacings", margin_spacings, "[0, inf)");
+  if (!finiteAtLeast(merge_area_ratio, 1.0))
+    return reject(why, "merge_area_ratio", merge_area_ratio, "[1, inf)");
+  if (!finiteAtLeast(target_step, 0.0))
+    return reject(why, "target_step", target_step, "[0, inf) [rad]");
+  if (!(std::isfinite(refinement_factor) && refinement_factor > 1.0))
+    return reject(why, "refinement_factor", refinement_factor, "(1, inf)");
+  if (!finiteAtLeast(min_refinement, 1.0))
+    return reject(why, "min_refinement", min_refinement, "[1, inf)");
+  if (!finiteAtLeast(transition_weight, 0.0))
+    return reject(why, "transition_weight", transition_weight, "[0, inf)");
+  if (!finiteAtLeast(leaf_weight, 0.0))
+    return reject(why, "leaf_weight", leaf_weight, "[0, inf)");
+  if (!finiteAtLeast(valid_edge_weight, 0.0))
+    return reject(why, "valid_edge_weight", valid_edge_weight, "[0, inf)");
+  if (!finiteAtLeast(small_segment_weight, 0.0))
+    return reject(why, "small_segment_weight", small_segment_weight, "[0, inf)");
+  if (!finiteAtLeast(sparse_weight, 0.0))
+    return reject(why, "sparse_weight", sparse_weight, "[0, inf)");
+  if (!finiteAtLeast(max_solid_angle, 0.0))
+    return reject(
+        why, "max_solid_angle", max_solid_angle, "[0, inf) [sr], 0 = no limit");
+  if (!(sample_yield > 0.0 && sample_yield <= 1.0))
+    return reject(why, "sample_yield", sample_yield, "(0, 1]");
+  return true;
+}
+
+double
+windowSolidAngle(double theta_min, double theta_max, double phi_min, double phi_max)
+{
+  // On the plane z = 1 the window is the rectangle [tan theta] x [tan phi]; the solid
+  // angle of [0, u] x [0, v] there is atan(u v / sqrt(1 + u^2 + v^2)).
+  const auto corner = [](double u, double v) {
+    return std::atan(u * v / std::sqrt(1.0 + u * u + v * v));
+  };
+  const double u0 = std::tan(theta_min), u1 = std::tan(theta_max);
+  const double v0 = std::tan(phi_min), v1 = std::tan(phi_max);
+  return corner(u1, v1) - corner(u0, v1) - corner(u1, v0) + corner(u0, v0);
+}
+
+bool
+computeRegionsOfInterest(const SegmentationResult& result,
+                         const SphericalTriangulation& tri,
+                         const Eigen::Affine3f& sensor_to_cloud,
+                         const RegionOfInterestParameters& p,
+                         std::vector<RegionOfInterest>& regions,
+                         RegionOfInterestStats* stats)
+{
+  regions.clear();
+  RegionOfInterestStats local;
+  RegionOfInterestStats& st = stats ? *stats : local;
+  st = RegionOfInterestStats();
+  std::string why;
+  if (!p.validate(&why)) {
+    PCL_ERROR("[pcl::selective_seg::computeRegionsOfInterest] %s\n", why.c_str());
+    return false;
+  }
+  const std::size_t nv = tri.vertex_point.size();
+  if (tri.vertex_angles.size() != nv || tri.vertex_positions.size() != nv ||
+      result.labels.size() != tri.point_vertex.size() ||
+      result.mesh.triangles.size() != tri.triangles.size() ||
+      result.mesh.classes.size() != tri.triangles.size() ||
+      tri.neighbours.size() != tri.triangles.size() ||
+      !sensor_to_cloud.matrix().allFinite()) {
+    PCL_ERROR("[pcl::selective_seg::computeRegionsOfInterest] the segmentation result "
+              "(%zu labels, %zu triangles) does not belong to the triangulation (%zu "
+              "points, %zu triangles), or the sensor pose is not finite\n",
+              result.labels.size(),
+              result.mesh.triangles.size(),
+              tri.point_vertex.size(),
+              tri.triangles.size());
+    return false;
+  }
+  for (std::size_t v = 0; v < nv; ++v)
+    if (tri.vertex_point[v] < 0 ||
+        static_cast<std::size_t>(tri.vertex_point[v]) >= result.labels.size()) {
+      PCL_ERROR("[pcl::selective_seg::computeRegionsOfInterest] vertex %zu has no "
+                "input point\n",
+                v);
+      return false;
+    }
+  const auto nt = static_cast<pcl::index_t>(tri.triangles.size());
+  for (std::size_t t = 0; t < tri.triangles.size(); ++t)
+    for (int k = 0; k < 3; ++k)
+      if (tri.triangles[t][k] < 0 ||
+          static_cast<std::size_t>(tri.triangles[t][k]) >= nv ||
+          tri.neighbours[t][k] < -1 || tri.neighbours[t][k] >= nt) {
+        PCL_ERROR(
+            "[pcl::selective_seg::computeRegionsOfInterest] triangle %zu refers to "
+            "a vertex or neighbour out of range\n",
+            t);
+        return false;
+      }
+  if (nv == 0)
+    return true;
+  std::vector<Eigen::Vector2d> angles(nv);
+  for (std::size_t v = 0; v < nv; ++v)
+    angles[v] = Eigen::Vector2d(tri.vertex_angles[v][0], tri.vertex_angles[v][1]) *
+                tri.angle_quantization;
+  const std::vector<double> spacing = vertexSpacing(tri, angles);
+  const Eigen::Affine3d to_cloud = sensor_to_cloud.cast<double>();
+  std::vector<double> strength;
+  const std::vector<std::uint8_t> kinds =
+      findEvidence(result, tri, to_cloud.inverse(), angles, spacing, p, strength);
+  for (const auto k : kinds) {
+    st.transition_vertices += (k & kTransition) != 0;
+    st.small_segment_vertices += (k & kSmallSegment) != 0;
+    st.sparse_vertices += (k & kSparse) != 0;
+  }
+  std::vector<Window> windows = makeTileWindows(tri, angles, kinds, spacing, p);
+  mergeWindows(windows, p);
+  st.candidates = windows.size();
+
+  std::vector<RegionOfInterest> candidates;
+  for (auto& w : windows) {
+    auto& ev = w.evidence;
+    std::sort(ev.begin(), ev.end());
+    ev.erase(std::unique(ev.begin(), ev.end()), ev.end());
+    std::vector<double> local;
+    double weighted = 0.0, covered = 0.0;
+    for (const auto v : ev) {
+      local.push_back(spacing[v]);
+      const double s2 = spacing[v] * spacing[v];
+      weighted += kindWeight(kinds[v], strength[v], p) * s2;
+      covered += s2;
+    }
+    RegionOfInterest r;
+    r.theta_min = w.theta_min;
+    r.theta_max = w.theta_max;
+    r.phi_min = w.phi_min;
+    r.phi_max = w.phi_max;
+    r.reasons = w.reasons;
+    r.num_evidence = ev.size();
+    r.current_step = median(local);
+    r.suggested_step =
+        p.target_step > 0.0 ? p.target_step : r.current_step / p.refinement_factor;
+    if (!(r.suggested_step > 0.0) ||
+        r.current_step < p.min_refinement * r.suggested_step) {
+      ++st.already_fine;
+      continue;
+    }
+    const double area = w.area();
+    r.solid_angle = windowSolidAngle(r.theta_min, r.theta_max, r.phi_min, r.phi_max);
+    r.estimated_points = static_cast<std::size_t>(
+        std::llround(p.sample_yield * area / (r.suggested_step * r.suggested_step)));
+    // Vertices are numbered in increasing quantized theta: the window's are a range.
+    const double q = tri.angle_quantization;
+    const auto first =
+        std::lower_bound(tri.vertex_angles.begin(),
+                         tri.vertex_angles.end(),
+                         r.theta_min / q,
+                         [](const QuantizedPoint& a, double t) { return a[0] < t; });
+    r.box_min = Eigen::Vector3f::Constant(std::numeric_limits<float>::max());
+    r.box_max = Eigen::Vector3f::Constant(std::numeric_limits<float>::lowest());
+    for (auto it = first; it != tri.vertex_angles.end() && (*it)[0] <= r.theta_max / q;
+         ++it) {
+      if ((*it)[1] < r.phi_min / q || (*it)[1] > r.phi_max / q)
+        continue;
+      const auto v = static_cast<std::size_t>(it - tri.vertex_angles.begin());
+      const Eigen::Vector3f x =
+          (to_cloud * tri.vertex_positions[v].cast<double>()).cast<float>();
+      r.box_min = r.box_min.cwiseMin(x);
+      r.box_max = r.box_max.cwiseMax(x);
+      ++r.num_points;
+    }
+    // The weighted share of the window's area its evidence stands for (each vertex
+    // spacing^2), times the share of new samples a scan at the suggested step brings.
+    r.priority =
+        weighted / std::max(area, covered) * (1.0 - r.suggested_step / r.current_step);
+    candidates.push_back(r);
+  }
+  std::sort(candidates.begin(), candidates.end(), [](const auto& a, const auto& b) {
+    return std::tie(b.priority, a.theta_min, a.phi_min, a.theta_max, a.phi_max) <
+           std::tie(a.priority, b.theta_min, b.phi_min, b.theta_max, b.phi_max);
+  });
+  for (const auto& r : candidates) {
+    const bool fits = (p.max_regions == 0 || regions.size() < p.max_regions) &&
+                      (p.max_points == 0 ||
+                       st.selected_points + r.estimated_points <= p.max_points) &&
+                      (p.max_solid_angle == 0.0 ||
+                       st.selected_solid_angle + r.solid_angle <= p.max_solid_angle);
+    if (!fits) {
+      ++st.over_budget;
+      continue;
+    }
+    regions.push_back(r);
+    st.selected_points += r.estimated_points;
+    st.selected_solid_angle += r.solid_angle;
+  }
+  st.selected = regions.size();
+  return true;
+}
+
+} // namespace selective_seg
+} // namespace pcl

@@ -1,0 +1,502 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
+ */
+
+// Regions of interest: known answers on a hand-made mesh and on the simulated cube
+// (windows on the cube's ground-truth edges), budgets, merging, the sensor frame with a
+// rotated sensor, bad input.
+
+#include <pcl_selective_seg/regions_of_interest.h>
+#include <pcl_selective_seg/selective_loop.h>
+#include <pcl_selective_seg/selective_segmentation.h>
+#include <pcl_selective_seg/sensor_simulator.h>
+
+#include <gtest/gtest.h>
+#include <pcl/common/transforms.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+namespace sim = pcl::selective_seg::simulation;
+using namespace pcl::selective_seg;
+
+namespace {
+
+/** A flat grid of columns x rows vertices at z = 1 with angular spacing step, two
+ * triangles per cell, every point its own vertex; the triangles of cell row
+ * \a edge_row are invalid edge triangles, all points label 1 except those of
+ * \a small_rows (label 2, a small segment). */
+struct GridMesh {
+  SphericalTriangulation tri;
+  SegmentationResult result;
+};
+
+GridMesh
+makeGrid(int columns,
+         int rows,
+         double step,
+         int edge_row,
+         std::pair<int, int> small_rows = {-1, -1})
+{
+  GridMesh g;
+  const double q = 1e-7;
+  g.tri.angle_quantization = q;
+  // Vertices in (theta, phi) order: column-major.
+  for (int c = 0; c < columns; ++c)
+    for (int r = 0; r < rows; ++r) {
+      const double theta = (c - columns / 2) * step;
+      const double phi = (r - rows / 2) * step;
+      g.tri.vertex_angles.push_back({static_cast<std::int32_t>(std::lround(theta / q)),
+                                     static_cast<std::int32_t>(std::lround(phi / q))});
+      g.tri.vertex_positions.emplace_back(std::tan(theta), std::tan(phi), 1.0f);
+      g.tri.vertex_point.push_back(
+          static_cast<pcl::index_t>(g.tri.vertex_point.size()));
+      g.tri.point_vertex.push_back(
+          static_cast<pcl::index_t>(g.tri.point_vertex.size()));
+    }
+  const auto id = [rows](int c, int r) {
+    return static_cast<pcl::index_t>(c * rows + r);
+  };
+  std::vector<bool> invalid;
+  for (int c = 0; c + 1 < columns; ++c)
+    for (int r = 0; r + 1 < rows; ++r) {
+      g.tri.triangles.push_back({id(c, r), id(c + 1, r), id(c + 1, r + 1)});
+      g.tri.triangles.push_back({id(c, r), id(c + 1, r + 1), id(c, r + 1)});
+      invalid.push_back(r == edge_row);
+      invalid.push_back(r == edge_row);
+    }
+  computeTriangleNeighbours(
+      g.tri.triangles, g.tri.vertex_point.size(), g.tri.neighbours);
+  const std::size_t n = g.tri.vertex_point.size();
+  g.result.labels.assign(n, 1);
+  std::size_t small = 0;
+  for (int c = 0; c < columns; ++c)
+    for (int r = small_rows.first; r >= 0 && r <= small_rows.second; ++r) {
+      g.result.labels[id(c, r)] = 2;
+      ++small;
+    }
+  g.result.segments.resize(2);
+  g.result.segments[0].label = 1;
+  g.result.segments[0].num_points = n - small;
+  g.result.segments[1].label = 2;
+  g.result.segments[1].num_points = small;
+  g.result.mesh.triangles = g.tri.triangles;
+  g.result.mesh.neighbours = g.tri.neighbours;
+  for (const bool bad : invalid)
+    g.result.mesh.classes.push_back(bad ? TriangleClass::InvalidEdge
+                                        : TriangleClass::Interior);
+  return g;
+}
+
+/** The paper's cube, coarse: about 2,500 points, level-A noise. */
+pcl::PointCloud<pcl::PointXYZL>::Ptr
+coarseCube(double step = 0.0108)
+{
+  const auto setup = sim::makeCubeScene();
+  sim::SensorParameters sensor = setup.sensor;
+  sensor.range_noise = 0.0005;
+  sim::SensorSimulator simulator;
+  EXPECT_TRUE(simulator.setParameters(sensor));
+  sim::ScanWindow w;
+  w.theta_min = sensor.theta_min;
+  w.theta_max = sensor.theta_max;
+  w.phi_min = sensor.phi_min;
+  w.phi_max = sensor.phi_max;
+  w.step = step;
+  auto cloud = pcl::make_shared<pcl::PointCloud<pcl::PointXYZL>>();
+  EXPECT_TRUE(simulator.simulateWindow(setup.scene, w, *cloud));
+  return cloud;
+}
+
+bool
+contains(const RegionOfInterest& r, double theta, double phi)
+{
+  return theta >= r.theta_min && theta <= r.theta_max && phi >= r.phi_min &&
+         phi <= r.phi_max;
+}
+
+/** The loop's settings for the coarse cube (docs/selective_sensing.md), no budget. */
+RegionOfInterestParameters
+noBudget()
+{
+  RegionOfInterestParameters p;
+  p.target_step = 0.0036;
+  p.max_window_size = 0.0216;
+  p.margin_spacings = 0.5;
+  return p;
+}
+
+} // namespace
+
+TEST(RegionsOfInterest, SolidAngleOfAWindow)
+{
+  // A cube face seen from the cube's centre: 4 pi / 6.
+  EXPECT_NEAR(windowSolidAngle(-M_PI / 4, M_PI / 4, -M_PI / 4, M_PI / 4),
+              4.0 * M_PI / 6.0,
+              1e-12);
+  // A small window on the axis: its angular area.
+  EXPECT_NEAR(windowSolidAngle(-0.001, 0.001, 0.0, 0.002), 4e-6, 1e-11);
+  // Additive over a split window.
+  EXPECT_NEAR(windowSolidAngle(0.1, 0.3, 0.2, 0.5),
+              windowSolidAngle(0.1, 0.2, 0.2, 0.5) +
+                  windowSolidAngle(0.2, 0.3, 0.2, 0.5),
+              1e-12);
+}
+
+TEST(RegionsOfInterest, ParametersNameTheBadOne)
+{
+  RegionOfInterestParameters p;
+  std::string why;
+  EXPECT_TRUE(p.validate(&why));
+  p.max_window_size = 0.0;
+  EXPECT_FALSE(p.validate(&why));
+  EXPECT_NE(why.find("max_window_size"), std::string::npos) << why;
+  p = RegionOfInterestParameters();
+  p.sample_yield = 1.5;
+  EXPECT_FALSE(p.validate(&why));
+  EXPECT_NE(why.find("sample_yield"), std::string::npos) << why;
+  p = RegionOfInterestParameters();
+  p.merge_area_ratio = 0.5;
+  EXPECT_FALSE(p.validate(&why));
+  EXPECT_NE(why.find("merge_area_ratio"), std::string::npos) << why;
+
+  const GridMesh g = makeGrid(10, 6, 0.01, 2);
+  std::vector<RegionOfInterest> regions(3);
+  p.merge_area_ratio = 0.5;
+  EXPECT_FALSE(computeRegionsOfInterest(
+      g.result, g.tri, Eigen::Affine3f::Identity(), p, regions));
+  EXPECT_TRUE(regions.empty());
+}
+
+TEST(RegionsOfInterest, EmptyAndMismatchedInput)
+{
+  std::vector<RegionOfInterest> regions(2);
+  RegionOfInterestStats stats;
+  EXPECT_TRUE(computeRegionsOfInterest(SegmentationResult(),
+                                       SphericalTriangulation(),
+                                       Eigen::Affine3f::Identity(),
+                                       RegionOfInterestParameters(),
+                                       regions,
+                                       &stats));
+  EXPECT_TRUE(regions.empty());
+  EXPECT_EQ(stats.candidates, 0u);
+
+  GridMesh g = makeGrid(10, 6, 0.01, 2);
+  g.result.labels.pop_back();
+  EXPECT_FALSE(computeRegionsOfInterest(g.result,
+                                        g.tri,
+                                        Eigen::Affine3f::Identity(),
+                                        RegionOfInterestParameters(),
+                                        regions));
+  g = makeGrid(10, 6, 0.01, 2);
+  g.result.mesh.classes.pop_back();
+  EXPECT_FALSE(computeRegionsOfInterest(g.result,
+                                        g.tri,
+                                        Eigen::Affine3f::Identity(),
+                                        RegionOfInterestParameters(),
+                                        regions));
+  g = makeGrid(10, 6, 0.01, 2);
+  g.tri.triangles[3][1] = 60; // 60 vertices
+  EXPECT_FALSE(computeRegionsOfInterest(g.result,
+                                        g.tri,
+                                        Eigen::Affine3f::Identity(),
+                                        RegionOfInterestParameters(),
+                                        regions));
+  g = makeGrid(10, 6, 0.01, 2);
+  g.tri.neighbours[0][0] = -2;
+  EXPECT_FALSE(computeRegionsOfInterest(g.result,
+                                        g.tri,
+                                        Eigen::Affine3f::Identity(),
+                                        RegionOfInterestParameters(),
+                                        regions));
+  // A segmentation without any evidence proposes nothing.
+  g = makeGrid(10, 6, 0.01, -1);
+  RegionOfInterestParameters p;
+  p.sparse_factor = 0.0;
+  EXPECT_TRUE(computeRegionsOfInterest(
+      g.result, g.tri, Eigen::Affine3f::Identity(), p, regions));
+  EXPECT_TRUE(regions.empty());
+}
+
+// Hand-computed: a band of invalid edge triangles between phi rows 2 and 3 of a grid of
+// 0.01 rad steps gives one window over the band, widened by half a spacing each side.
+TEST(RegionsOfInterest, WindowOverABandOfInvalidEdgeTriangles)
+{
+  const GridMesh g = makeGrid(10, 8, 0.01, 3); // phi rows -4..3, band between 3 and 4
+  RegionOfInterestParameters p;
+  p.sparse_factor = 0.0;
+  p.margin_spacings = 0.5;
+  p.max_window_size = 1.0;
+  p.refinement_factor = 2.0;
+  std::vector<RegionOfInterest> regions;
+  RegionOfInterestStats stats;
+  ASSERT_TRUE(computeRegionsOfInterest(
+      g.result, g.tri, Eigen::Affine3f::Identity(), p, regions, &stats));
+  // The band's vertices: columns 0..9 of rows 3 and 4 (the grid's boundary edges are
+  // one spacing long, no hull slivers, so their end points stay evidence).
+  EXPECT_EQ(stats.transition_vertices, 20u);
+  ASSERT_EQ(regions.size(), 1u);
+  const auto& r = regions[0];
+  EXPECT_EQ(r.reasons, kTransition);
+  EXPECT_EQ(r.num_evidence, 20u);
+  // Median spacing of the band's vertices: the grid step.
+  EXPECT_NEAR(r.current_step, 0.01, 1e-9);
+  EXPECT_NEAR(r.suggested_step, 0.005, 1e-9);
+  EXPECT_NEAR(r.theta_min, -0.05 - 0.005, 1e-6);
+  EXPECT_NEAR(r.theta_max, 0.04 + 0.005, 1e-6);
+  EXPECT_NEAR(r.phi_min, -0.01 - 0.005, 1e-6);
+  EXPECT_NEAR(r.phi_max, 0.0 + 0.005, 1e-6);
+  EXPECT_NEAR(r.solid_angle, windowSolidAngle(-0.055, 0.045, -0.015, 0.005), 1e-12);
+  EXPECT_EQ(r.estimated_points,
+            static_cast<std::size_t>(std::llround(0.1 * 0.02 / 25e-6)));
+  // The points in the window: columns 0..9 of the rows -1 and 0.
+  EXPECT_EQ(r.num_points, 20u);
+  EXPECT_NEAR(r.box_min.z(), 1.0f, 1e-6f);
+  EXPECT_GT(r.priority, 0.0);
+  EXPECT_LE(r.priority, p.transition_weight);
+}
+
+// Windows of different reasons over the same place merge into one with both reasons;
+// tiles never grow beyond max_window_size.
+TEST(RegionsOfInterest, OverlappingWindowsMerge)
+{
+  // The band of invalid triangles lies inside a small segment (rows 2..5: 40 of 120
+  // points).
+  const GridMesh g = makeGrid(10, 12, 0.01, 3, {2, 5});
+  RegionOfInterestParameters p;
+  p.sparse_factor = 0.0;
+  p.small_segment_points = 50;
+  p.max_window_size = 1.0;
+  std::vector<RegionOfInterest> regions;
+  RegionOfInterestStats stats;
+  ASSERT_TRUE(computeRegionsOfInterest(
+      g.result, g.tri, Eigen::Affine3f::Identity(), p, regions, &stats));
+  ASSERT_EQ(regions.size(), 1u);
+  EXPECT_EQ(regions[0].reasons, kTransition | kSmallSegment);
+  EXPECT_EQ(stats.candidates, 1u);
+
+  // Small tiles: several windows along the band, none wider than a tile plus margins.
+  p.max_window_size = 0.03;
+  p.margin_spacings = 0.5;
+  ASSERT_TRUE(computeRegionsOfInterest(
+      g.result, g.tri, Eigen::Affine3f::Identity(), p, regions, &stats));
+  EXPECT_GE(regions.size(), 3u);
+  for (const auto& r : regions)
+    EXPECT_LE(r.theta_max - r.theta_min, 0.03 + 0.01 + 1e-9);
+}
+
+// The simulated cube: without a budget the windows cover the cube's ground-truth edges
+// and little else; the budget picks the best windows; the output is deterministic.
+class CubeRegions : public ::testing::Test {
+protected:
+  static void SetUpTestSuite()
+  {
+    cloud_ = coarseCube();
+    seg_ = new SelectiveSegmentation<pcl::PointXYZL>();
+    seg_->setInputCloud(cloud_);
+    std::vector<pcl::PointIndices> clusters;
+    ASSERT_TRUE(seg_->extract(clusters));
+    reference_ = new sim::ReferenceBoundary();
+    ASSERT_TRUE(sim::makeReferenceBoundary(sim::makeCubeScene(), 0.004, *reference_));
+  }
+  static void TearDownTestSuite()
+  {
+    delete seg_;
+    delete reference_;
+  }
+  static pcl::PointCloud<pcl::PointXYZL>::Ptr cloud_;
+  static SelectiveSegmentation<pcl::PointXYZL>* seg_;
+  static sim::ReferenceBoundary* reference_;
+};
+pcl::PointCloud<pcl::PointXYZL>::Ptr CubeRegions::cloud_;
+SelectiveSegmentation<pcl::PointXYZL>* CubeRegions::seg_ = nullptr;
+sim::ReferenceBoundary* CubeRegions::reference_ = nullptr;
+
+TEST_F(CubeRegions, WindowsCoverTheGroundTruthEdges)
+{
+  // Transition regions from edge triangles only (segment borders, valid or not): the
+  // edges of the scene.
+  RegionOfInterestParameters p = noBudget();
+  p.small_segment_points = 0;
+  p.sparse_factor = 0.0;
+  p.leaf_sigma_threshold = 0.0;
+  p.use_valid_edges = true;
+  std::vector<RegionOfInterest> regions;
+  RegionOfInterestStats stats;
+  ASSERT_TRUE(computeRegionsOfInterest(*seg_, p, regions, &stats));
+  ASSERT_FALSE(regions.empty());
+  EXPECT_EQ(stats.selected, regions.size());
+  EXPECT_EQ(stats.over_budget, 0u);
+  std::size_t covered = 0;
+  for (const auto& p : reference_->points) {
+    const double theta = std::atan2(p.x, p.z), phi = std::atan2(p.y, p.z);
+    covered += std::any_of(regions.begin(), regions.end(), [&](const auto& r) {
+      return contains(r, theta, phi);
+    });
+  }
+  const double fraction = double(covered) / double(reference_->points.size());
+  EXPECT_GT(fraction, 0.8) << covered << " of " << reference_->points.size();
+  for (const auto& r : regions)
+    EXPECT_EQ(r.reasons, kTransition);
+  // ... while the windows together (overlaps counted twice) are well under half the
+  // view (0.51 sr).
+  double solid_angle = 0.0;
+  for (const auto& r : regions)
+    solid_angle += r.solid_angle;
+  const auto s = sim::makeCubeScene().sensor;
+  EXPECT_LT(solid_angle,
+            0.45 * windowSolidAngle(s.theta_min, s.theta_max, s.phi_min, s.phi_max));
+  // Sorted by priority.
+  for (std::size_t i = 1; i < regions.size(); ++i)
+    EXPECT_GE(regions[i - 1].priority, regions[i].priority);
+}
+
+TEST_F(CubeRegions, BudgetsAreRespected)
+{
+  std::vector<RegionOfInterest> all, some;
+  ASSERT_TRUE(computeRegionsOfInterest(*seg_, noBudget(), all));
+  ASSERT_GT(all.size(), 10u);
+
+  RegionOfInterestParameters p = noBudget();
+  p.max_regions = 5;
+  ASSERT_TRUE(computeRegionsOfInterest(*seg_, p, some));
+  ASSERT_EQ(some.size(), 5u);
+  for (std::size_t i = 0; i < 5; ++i) // greedy: the five best
+    EXPECT_EQ(some[i].theta_min, all[i].theta_min);
+
+  p = noBudget();
+  p.max_points = 1000;
+  RegionOfInterestStats stats;
+  ASSERT_TRUE(computeRegionsOfInterest(*seg_, p, some, &stats));
+  ASSERT_FALSE(some.empty());
+  std::size_t points = 0;
+  for (const auto& r : some)
+    points += r.estimated_points;
+  EXPECT_LE(points, 1000u);
+  EXPECT_EQ(points, stats.selected_points);
+  EXPECT_GT(stats.over_budget, 0u);
+
+  p = noBudget();
+  p.max_solid_angle = 0.01;
+  ASSERT_TRUE(computeRegionsOfInterest(*seg_, p, some));
+  ASSERT_FALSE(some.empty());
+  double sr = 0.0;
+  for (const auto& r : some)
+    sr += r.solid_angle;
+  EXPECT_LE(sr, 0.01);
+}
+
+TEST_F(CubeRegions, NoMergeableOverlapRemains)
+{
+  const RegionOfInterestParameters p = noBudget();
+  std::vector<RegionOfInterest> regions;
+  ASSERT_TRUE(computeRegionsOfInterest(*seg_, p, regions));
+  for (std::size_t i = 0; i < regions.size(); ++i)
+    for (std::size_t j = i + 1; j < regions.size(); ++j) {
+      const auto& a = regions[i];
+      const auto& b = regions[j];
+      const double w =
+          std::min(a.theta_max, b.theta_max) - std::max(a.theta_min, b.theta_min);
+      const double h = std::min(a.phi_max, b.phi_max) - std::max(a.phi_min, b.phi_min);
+      if (w <= 0.0 || h <= 0.0)
+        continue;
+      const double uw =
+          std::max(a.theta_max, b.theta_max) - std::min(a.theta_min, b.theta_min);
+      const double uh = std::max(a.phi_max, b.phi_max) - std::min(a.phi_min, b.phi_min);
+      const double area_a = (a.theta_max - a.theta_min) * (a.phi_max - a.phi_min);
+      const double area_b = (b.theta_max - b.theta_min) * (b.phi_max - b.phi_min);
+      const bool fits =
+          uw <= std::max({p.max_window_size,
+                          a.theta_max - a.theta_min,
+                          b.theta_max - b.theta_min}) &&
+          uh <= std::max(
+                    {p.max_window_size, a.phi_max - a.phi_min, b.phi_max - b.phi_min});
+      EXPECT_FALSE(fits && uw * uh <= p.merge_area_ratio * (area_a + area_b - w * h))
+          << "windows " << i << " and " << j << " should have merged";
+    }
+}
+
+// Windows are in the sensor frame: moving and turning the sensor together with the
+// scene changes no window; the boxes follow the cloud frame.
+TEST_F(CubeRegions, SensorFrameWithARotatedSensor)
+{
+  Eigen::Affine3f pose = Eigen::Affine3f::Identity();
+  pose.translate(Eigen::Vector3f(1.0f, -2.0f, 0.5f));
+  pose.rotate(Eigen::AngleAxisf(0.7f, Eigen::Vector3f(0.3f, 1.0f, -0.2f).normalized()));
+  auto moved = pcl::make_shared<pcl::PointCloud<pcl::PointXYZL>>();
+  pcl::transformPointCloud(*cloud_, *moved, pose);
+  moved->sensor_origin_.head<3>() = pose.translation();
+  moved->sensor_origin_[3] = 0.0f;
+  moved->sensor_orientation_ = Eigen::Quaternionf(pose.linear());
+  SelectiveSegmentation<pcl::PointXYZL> seg;
+  seg.setInputCloud(moved);
+  std::vector<pcl::PointIndices> clusters;
+  ASSERT_TRUE(seg.extract(clusters));
+  std::vector<RegionOfInterest> a, b;
+  ASSERT_TRUE(computeRegionsOfInterest(*seg_, noBudget(), a));
+  ASSERT_TRUE(computeRegionsOfInterest(seg, noBudget(), b));
+  // Float rounding of the moved points may shift a few vertices by a quantum; the
+  // windows agree to well under a spacing.
+  ASSERT_NEAR(double(a.size()), double(b.size()), 0.05 * a.size());
+  std::size_t matched = 0;
+  for (const auto& r : a) {
+    const auto same = std::find_if(b.begin(), b.end(), [&](const auto& s) {
+      return std::abs(s.theta_min - r.theta_min) < 1e-4 &&
+             std::abs(s.theta_max - r.theta_max) < 1e-4 &&
+             std::abs(s.phi_min - r.phi_min) < 1e-4 &&
+             std::abs(s.phi_max - r.phi_max) < 1e-4;
+    });
+    if (same == b.end())
+      continue;
+    ++matched;
+    // The cloud-frame box of the moved scan holds the moved box centre.
+    const Eigen::Vector3f centre = pose * (0.5f * (r.box_min + r.box_max));
+    EXPECT_TRUE((centre.array() >= same->box_min.array() - 0.05f).all() &&
+                (centre.array() <= same->box_max.array() + 0.05f).all());
+  }
+  EXPECT_GT(matched, a.size() * 9 / 10);
+}
+
+TEST_F(CubeRegions, ShuffledCloudGivesTheSameWindows)
+{
+  auto shuffled = pcl::make_shared<pcl::PointCloud<pcl::PointXYZL>>(*cloud_);
+  std::mt19937 engine(5);
+  std::shuffle(shuffled->points.begin(), shuffled->points.end(), engine);
+  SelectiveSegmentation<pcl::PointXYZL> seg;
+  seg.setInputCloud(shuffled);
+  std::vector<pcl::PointIndices> clusters;
+  ASSERT_TRUE(seg.extract(clusters));
+  std::vector<RegionOfInterest> a, b;
+  ASSERT_TRUE(computeRegionsOfInterest(*seg_, noBudget(), a));
+  ASSERT_TRUE(computeRegionsOfInterest(seg, noBudget(), b));
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].theta_min, b[i].theta_min);
+    EXPECT_EQ(a[i].phi_max, b[i].phi_max);
+    EXPECT_EQ(a[i].priority, b[i].priority);
+    EXPECT_EQ(a[i].estimated_points, b[i].estimated_points);
+  }
+}
+
+// A refined region proposes no window again.
+TEST_F(CubeRegions, FinelyScannedEvidenceIsSpent)
+{
+  std::vector<RegionOfInterest> regions;
+  RegionOfInterestStats fine, coarse;
+  ASSERT_TRUE(computeRegionsOfInterest(*seg_, noBudget(), regions, &fine));
+  RegionOfInterestParameters p = noBudget();
+  p.target_step = 0.025; // coarser than most of the scan already is
+  ASSERT_TRUE(computeRegionsOfInterest(*seg_, p, regions, &coarse));
+  EXPECT_LT(coarse.transition_vertices * 10, fine.transition_vertices);
+  EXPECT_LT(coarse.candidates * 5, fine.candidates);
+}
+
+TEST(RegionsOfInterest, ReasonNames)
+{
+  EXPECT_EQ(reasonsToString(kTransition), "transition");
+  EXPECT_EQ(reasonsToString(kTransition | kSparse), "transition+sparse");
+  EXPECT_EQ(reasonsToString(0), "");
+}

@@ -1,0 +1,150 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
+ */
+
+// Window scans of the simulator and a small run of the simulated coarse-to-fine loop:
+// with ground truth, a refinement round must improve the boundary accuracy.
+
+#include <pcl_selective_seg/selective_loop.h>
+#include <pcl_selective_seg/sensor_simulator.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace sim = pcl::selective_seg::simulation;
+
+namespace {
+
+sim::ScanWindow
+window(double theta_min, double theta_max, double phi_min, double phi_max, double step)
+{
+  sim::ScanWindow w;
+  w.theta_min = theta_min;
+  w.theta_max = theta_max;
+  w.phi_min = phi_min;
+  w.phi_max = phi_max;
+  w.step = step;
+  return w;
+}
+
+sim::SimulationSetup
+cube()
+{
+  auto setup = sim::makeCubeScene();
+  setup.sensor.range_noise = 0.0005;
+  return setup;
+}
+
+} // namespace
+
+TEST(SimulateWindow, PointsLieInTheWindowAndFollowTheStep)
+{
+  const auto setup = cube();
+  sim::SensorSimulator simulator;
+  ASSERT_TRUE(simulator.setParameters(setup.sensor));
+  pcl::PointCloud<pcl::PointXYZL> coarse, fine, again, other;
+  sim::SimulationDetails details;
+  const auto w = window(-0.1, 0.1, 0.4, 0.6, 0.004);
+  ASSERT_TRUE(simulator.simulateWindow(setup.scene, w, coarse, &details));
+  EXPECT_EQ(details.candidates, 50u * 50u);
+  EXPECT_EQ(details.exact_ranges.size(), coarse.size());
+  ASSERT_GT(coarse.size(), 500u);
+  for (const auto& p : coarse) {
+    const double theta = std::atan2(p.x, p.z), phi = std::atan2(p.y, p.z);
+    EXPECT_GE(theta, w.theta_min - 1e-6);
+    EXPECT_LE(theta, w.theta_max + 1e-6);
+    EXPECT_GE(phi, w.phi_min - 1e-6);
+    EXPECT_LE(phi, w.phi_max + 1e-6);
+    EXPECT_GE(p.label, 1u);
+  }
+  // Half the step: four times the rays, about four times the points.
+  auto half = w;
+  half.step = 0.002;
+  ASSERT_TRUE(simulator.simulateWindow(setup.scene, half, fine));
+  const double ratio = double(fine.size()) / double(coarse.size());
+  EXPECT_GT(ratio, 3.5);
+  EXPECT_LT(ratio, 4.5);
+  // Same window and id: the same cloud; another id: other rays.
+  ASSERT_TRUE(simulator.simulateWindow(setup.scene, w, again));
+  ASSERT_EQ(again.size(), coarse.size());
+  for (std::size_t i = 0; i < coarse.size(); ++i)
+    EXPECT_EQ(again[i].getVector3fMap(), coarse[i].getVector3fMap());
+  auto w2 = w;
+  w2.scan_id = 7;
+  ASSERT_TRUE(simulator.simulateWindow(setup.scene, w2, other));
+  EXPECT_NE(other[0].getVector3fMap(), coarse[0].getVector3fMap());
+}
+
+TEST(SimulateWindow, BadWindowsAreRejected)
+{
+  const auto setup = cube();
+  sim::SensorSimulator simulator;
+  pcl::PointCloud<pcl::PointXYZL> cloud;
+  cloud.push_back(pcl::PointXYZL());
+  std::string why;
+  auto w = window(0.2, 0.1, 0.0, 0.1, 0.01);
+  EXPECT_FALSE(w.validate(&why));
+  EXPECT_NE(why.find("theta_min"), std::string::npos) << why;
+  EXPECT_FALSE(simulator.simulateWindow(setup.scene, w, cloud));
+  EXPECT_TRUE(cloud.empty());
+  w = window(0.0, 0.1, 0.0, 1.6, 0.01);
+  EXPECT_FALSE(w.validate(&why));
+  EXPECT_NE(why.find("phi"), std::string::npos) << why;
+  w = window(0.0, 0.1, 0.0, 0.1, 0.0);
+  EXPECT_FALSE(w.validate(&why));
+  EXPECT_NE(why.find("step"), std::string::npos) << why;
+  w = window(-1.0, 1.0, -1.0, 1.0, 1e-6); // 4e12 cells
+  EXPECT_FALSE(w.validate(&why));
+  EXPECT_NE(why.find("1e8"), std::string::npos) << why;
+}
+
+TEST(SelectiveLoop, RefinementImprovesTheBoundaryAccuracy)
+{
+  const auto setup = cube();
+  const double fine = 0.0045;
+  sim::ReferenceBoundary reference;
+  ASSERT_TRUE(sim::makeReferenceBoundary(setup, 0.5 * fine, reference));
+  ASSERT_GT(reference.points.size(), 500u);
+
+  sim::ScanScore coarse_uniform, dense;
+  ASSERT_TRUE(sim::runUniformScan(setup, 3.0 * fine, {}, reference, coarse_uniform));
+  ASSERT_TRUE(sim::runUniformScan(setup, fine, {}, reference, dense));
+  // Finer uniform scans find the edges more accurately.
+  EXPECT_LT(dense.accuracy.mean, 0.8 * coarse_uniform.accuracy.mean);
+
+  sim::SelectiveLoopParameters params;
+  params.fine_step = fine;
+  params.iterations = 2;
+  params.point_budget = dense.points * 3 / 10;
+  params.regions.margin_spacings = 0.5; // as pcl_selective_seg_selective_loop
+  std::vector<sim::ScanScore> rounds;
+  int calls = 0;
+  ASSERT_TRUE(sim::runSelectiveLoop(
+      setup, params, reference, rounds, [&](const sim::LoopRound& r) {
+        EXPECT_EQ(r.iteration, calls++);
+        EXPECT_EQ(r.cloud->size(), r.result->labels.size());
+      }));
+  ASSERT_EQ(rounds.size(), 3u);
+  EXPECT_EQ(calls, 3);
+  EXPECT_LT(rounds[0].points, rounds[1].points);
+  EXPECT_LT(rounds[1].points, rounds[2].points);
+  EXPECT_LE(rounds.back().points, params.point_budget * 105 / 100);
+  // The refinement rounds bring the boundaries closer to the truth.
+  EXPECT_LT(rounds.back().accuracy.mean, 0.8 * rounds[0].accuracy.mean);
+}
+
+TEST(SelectiveLoop, BadParametersAreRejected)
+{
+  sim::ReferenceBoundary reference;
+  std::vector<sim::ScanScore> rounds(1);
+  sim::SelectiveLoopParameters params;
+  params.fine_step = 0.0;
+  EXPECT_FALSE(sim::runSelectiveLoop(cube(), params, reference, rounds));
+  EXPECT_TRUE(rounds.empty());
+  params = sim::SelectiveLoopParameters();
+  params.point_budget = 0;
+  EXPECT_FALSE(sim::runSelectiveLoop(cube(), params, reference, rounds));
+}
