@@ -170,11 +170,16 @@ SelectiveSegmentation<PointT>::buildOctree()
   }
   // The finest voxel: the parameter, or a multiple of the point spacing, but never so
   // small that the tree would exceed its maximum depth.
-  const double extent = (hi - lo).template cast<double>().maxCoeff();
+  // In double: the difference of two floats near float's limits overflows float.
+  const double extent =
+      (hi.template cast<double>() - lo.template cast<double>()).maxCoeff();
   double resolution = params_.min_voxel_size > 0.0
                           ? params_.min_voxel_size
                           : params_.min_voxel_size_factor * result_.median_spacing;
-  resolution = std::max(resolution, extent / std::ldexp(1.0, params_.max_octree_depth));
+  // 2^depth - 1 voxels: the octree pads its box by a hundredth of a voxel, which must
+  // not take it one level deeper than max_octree_depth.
+  resolution =
+      std::max(resolution, extent / (std::ldexp(1.0, params_.max_octree_depth) - 1.0));
   if (!(resolution > 0.0) || !std::isfinite(resolution))
     resolution = extent > 0.0 && std::isfinite(extent) ? extent : 1.0;
   result_.min_voxel_size = resolution;
