@@ -14,6 +14,8 @@
 #include <pcl/console/print.h>
 #include <pcl/conversions.h>
 
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -87,6 +89,28 @@ SelectiveSegmentation<PointT>::triangulate()
                 "the " + std::to_string(tri.vertex_point.size()) +
                     " distinct viewing directions are fewer than three or all on one "
                     "line in (theta, phi): there is no surface to triangulate");
+  // Points on one 3-D line that misses the sensor have distinct directions and are
+  // triangulated, but their triangles' areas are float rounding: any segment would be
+  // noise. Their spread across the line must exceed 1e-5 of their spread along it.
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const auto& p : tri.vertex_positions)
+    mean += p.template cast<double>();
+  mean /= static_cast<double>(tri.vertex_positions.size());
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (const auto& p : tri.vertex_positions) {
+    const Eigen::Vector3d d = p.template cast<double>() - mean;
+    scatter += d * d.transpose();
+  }
+  const Eigen::Vector3d spread =
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter, Eigen::EigenvaluesOnly)
+          .eigenvalues()
+          .cwiseMax(0.0)
+          .cwiseSqrt(); // increasing
+  if (spread.allFinite() && !(spread[1] > 1e-5 * spread[2]))
+    return fail("extract",
+                "the " + std::to_string(tri.vertex_point.size()) +
+                    " distinct points lie on one line in 3-D (to float precision): "
+                    "there is no surface to segment");
   return true;
 }
 
