@@ -14,8 +14,6 @@
 #include <pcl/console/print.h>
 #include <pcl/conversions.h>
 
-#include <Eigen/Eigenvalues>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -91,24 +89,36 @@ SelectiveSegmentation<PointT>::triangulate()
                     "line in (theta, phi): there is no surface to triangulate");
   // Points on one 3-D line that misses the sensor have distinct directions and are
   // triangulated, but their triangles' areas are float rounding: any segment would be
-  // noise. Their spread across the line must exceed 1e-5 of their spread along it.
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (const auto& p : tri.vertex_positions)
-    mean += p.template cast<double>();
-  mean /= static_cast<double>(tri.vertex_positions.size());
-  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
-  for (const auto& p : tri.vertex_positions) {
-    const Eigen::Vector3d d = p.template cast<double>() - mean;
-    scatter += d * d.transpose();
+  // noise. The line through vertex 0 and the vertex farthest from it must leave some
+  // vertex by more than a few float roundings of the coordinates. (An exact test:
+  // a far outlier cannot make a surface look like a line, as a principal axis would.)
+  const auto& pos = tri.vertex_positions;
+  const Eigen::Vector3d a = pos[0].template cast<double>();
+  std::size_t far = 0;
+  double far_distance = 0.0;
+  for (std::size_t v = 1; v < pos.size(); ++v) {
+    const double d = (pos[v].template cast<double>() - a).squaredNorm();
+    if (d > far_distance) {
+      far = v;
+      far_distance = d;
+    }
   }
-  const Eigen::Vector3d spread =
-      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter, Eigen::EigenvaluesOnly)
-          .eigenvalues()
-          .cwiseMax(0.0)
-          .cwiseSqrt(); // increasing
-  if (spread.allFinite() && !(spread[1] > 1e-5 * spread[2]))
+  const Eigen::Vector3d b = pos[far].template cast<double>();
+  const double length = std::sqrt(far_distance);
+  const Eigen::Vector3d axis = (b - a) / length;
+  const double tolerance = 16.0 * std::numeric_limits<float>::epsilon();
+  bool on_line = far_distance > 0.0;
+  for (std::size_t v = 1; on_line && v < pos.size(); ++v) {
+    const Eigen::Vector3d p = pos[v].template cast<double>();
+    const Eigen::Vector3d off = (p - a) - axis * axis.dot(p - a);
+    // The rounding of p, and that of a and b carried to p along the line.
+    const double rounding =
+        p.norm() + (a.norm() * (p - b).norm() + b.norm() * (p - a).norm()) / length;
+    on_line = off.norm() <= tolerance * rounding;
+  }
+  if (on_line)
     return fail("extract",
-                "the " + std::to_string(tri.vertex_point.size()) +
+                "the " + std::to_string(pos.size()) +
                     " distinct points lie on one line in 3-D (to float precision): "
                     "there is no surface to segment");
   return true;
