@@ -107,6 +107,20 @@ TEST(HostileInput, AllPointsOnOneLine)
   EXPECT_FALSE(run.ok);
 }
 
+// A wall with one far outlier (1e30 m, and -FLT_MAX / 3 in y): the scene is no line,
+// whatever the outlier does to the extent and the voxel size. Every wall point labeled.
+TEST(HostileInput, AFarOutlierDoesNotHideTheSurface)
+{
+  for (const float y : {1e30f, -std::numeric_limits<float>::max() / 3}) {
+    auto cloud = wall(100, 100);
+    cloud->push_back(pcl::PointXYZ(1e30f, y, 1e30f));
+    Segmented run(cloud);
+    ASSERT_TRUE(run.ok) << y;
+    for (std::size_t i = 0; i + 1 < cloud->size(); ++i)
+      ASSERT_GT(run.seg.getResult().labels[i], 0u) << i;
+  }
+}
+
 // 100 x 100 directions, each hit at 40 ranges from 1 m to 2^39 m (a ray through 40
 // surfaces; powers of two keep the directions exact in float): every point shares the
 // vertex of its direction, represented by the nearest hit, so all 400,000 points take
