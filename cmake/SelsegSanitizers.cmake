@@ -31,3 +31,17 @@ if(SELSEG_SANITIZE)
   add_link_options(-fsanitize=address,undefined)
   message(STATUS "Sanitizers: ${SELSEG_SANITIZER_FLAGS}")
 endif()
+
+# With clang the sanitizer runtime is linked into executables only, so a shared library
+# built with the sanitizers has undefined __asan_* symbols until it is loaded: drop
+# --no-undefined from such a library's link options.
+function(selseg_sanitizer_allow_runtime_symbols target)
+  if(NOT SELSEG_SANITIZE)
+    return()
+  endif()
+  get_target_property(options ${target} LINK_OPTIONS)
+  if(options)
+    list(REMOVE_ITEM options "LINKER:--no-undefined")
+    set_target_properties(${target} PROPERTIES LINK_OPTIONS "${options}")
+  endif()
+endfunction()
