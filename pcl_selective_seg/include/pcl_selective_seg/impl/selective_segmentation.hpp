@@ -211,9 +211,11 @@ SelectiveSegmentation<PointT>::buildOctree()
                           ? params_.min_voxel_size
                           : params_.min_voxel_size_factor * result_.median_spacing;
   // 2^depth - 1 voxels: the octree pads its box by a hundredth of a voxel, which must
-  // not take it one level deeper than max_octree_depth.
+  // not take it one level deeper than max_octree_depth. The box is at least 2 float
+  // epsilons wide (OctreePointCloudNormalVariance: PCL's octree subtracts one).
+  const double box = std::max(extent, 2.0 * std::numeric_limits<float>::epsilon());
   resolution =
-      std::max(resolution, extent / (std::ldexp(1.0, params_.max_octree_depth) - 1.0));
+      std::max(resolution, box / (std::ldexp(1.0, params_.max_octree_depth) - 1.0));
   if (!(resolution > 0.0) || !std::isfinite(resolution))
     resolution = extent > 0.0 && std::isfinite(extent) ? extent : 1.0;
   result_.min_voxel_size = resolution;
