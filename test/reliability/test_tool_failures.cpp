@@ -297,7 +297,9 @@ TEST_F(ToolFailure, UnwritableLocationsLeaveNothing)
 TEST_F(ToolFailure, FullDiskLeavesNothing)
 {
   writeFile(dir / "out" / "labels.pcd", "old labels");
-  for (const long limit : {0L, 16L, 600L, 2000L}) {
+  // (Not 0 KiB: LLVM's OpenMP runtime, in clang builds, then cannot create its
+  // registration file in /dev/shm and aborts at start-up, before the tool runs.)
+  for (const long limit : {4L, 16L, 600L, 2000L}) {
     const Outcome o = run(shellQuoted(scan) + " -ignore_viewpoint" + allOutputs(), limit);
     EXPECT_EQ(o.code, 1) << limit << " KiB: " << o.messages;
     EXPECT_NE(o.messages.find("free space"), std::string::npos) << o.messages;
