@@ -100,8 +100,9 @@ expectConsistentResult(const pcl::PointCloud<PointT>& cloud,
   for (std::size_t s = 0; s < clusters.size(); ++s) {
     EXPECT_FALSE(clusters[s].indices.empty()) << "segment " << s + 1;
     EXPECT_EQ(clusters[s].indices.size(), r.segments[s].num_points);
-    if (s > 0)
+    if (s > 0) {
       EXPECT_LE(clusters[s].indices.size(), clusters[s - 1].indices.size());
+    }
     in_clusters += clusters[s].indices.size();
   }
   EXPECT_EQ(in_clusters, labeled);

@@ -149,11 +149,13 @@ TEST(Determinism, ToolOutputsAreByteIdentical)
     for (const char* name : {"labels.pcd", "mesh.ply", "leaves.pcd"}) {
       const std::string content = read(dir / name);
       ASSERT_FALSE(content.empty()) << name;
-      if (first.count(name))
+      if (first.count(name)) {
         EXPECT_TRUE(content == first[name]) << name << " differs with " << threads
                                             << " threads";
-      else
+      }
+      else {
         first[name] = content;
+      }
     }
   }
   fs::remove_all(dir);
