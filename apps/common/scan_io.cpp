@@ -16,6 +16,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <vector>
 
@@ -95,9 +96,9 @@ bytesAfter(const std::string& path, unsigned long long from)
   return size >= from ? static_cast<long long>(size - from) : -1;
 }
 
-/** A header's claims against the file's size: every stored value takes at least one
- * byte (binary) or two (text), so a header promising more values than the file can
- * hold is truncated or corrupt, and must not make us allocate what it claims. */
+/** A header's claims against the file's size: \a values is the least number of bytes
+ * the data it declares can take; a header promising more than the file holds is
+ * truncated or corrupt, and must not make us allocate what it claims. */
 bool
 plausibleSize(const std::string& path,
               unsigned long long values,
@@ -106,10 +107,10 @@ plausibleSize(const std::string& path,
 {
   if (data_bytes >= 0 && values <= static_cast<unsigned long long>(data_bytes))
     return true;
-  error = "cannot read '" + path + "': its header promises " + std::to_string(values) +
-          " values but the file holds only " +
+  error = "cannot read '" + path + "': its header promises at least " +
+          std::to_string(values) + " bytes of data but the file holds only " +
           std::to_string(std::max<long long>(data_bytes, 0)) +
-          " bytes of data: the file is truncated or corrupt";
+          ": the file is truncated or corrupt";
   return false;
 }
 
@@ -122,53 +123,79 @@ pcdSizesPlausible(const std::string& path, std::string& error)
   std::string line;
   unsigned long long width = 0, height = 1, points = 0, bytes_per_point = 0,
                      values_per_point = 0;
+  std::vector<std::string> fields, types;
   std::vector<unsigned long long> sizes, counts;
   std::string data;
-  while (data.empty() && std::getline(in, line)) {
+  bool data_seen = false;
+  std::set<std::string> seen;
+  const auto corrupt = [&](const std::string& why) {
+    error = "cannot read '" + path + "' as PCD: " + why + ": the header is corrupt";
+    return false;
+  };
+  while (!data_seen && std::getline(in, line)) {
     std::istringstream words(line);
-    std::string key;
+    std::string key, word;
     words >> key;
-    unsigned long long v = 0;
-    if (key == "SIZE")
-      while (words >> v)
-        sizes.push_back(v);
-    else if (key == "COUNT")
-      while (words >> v)
-        counts.push_back(v);
-    else if (key == "WIDTH")
-      words >> width;
-    else if (key == "HEIGHT")
-      words >> height;
-    else if (key == "POINTS")
-      words >> points;
-    else if (key == "DATA")
-      words >> data;
+    std::vector<std::string> rest;
+    while (words >> word)
+      rest.push_back(word);
+    const auto numbers = [&](std::vector<unsigned long long>& out) {
+      for (const auto& w : rest) {
+        if (w.empty() || w.find_first_not_of("0123456789") != std::string::npos ||
+            w.size() > 12)
+          return false;
+        out.push_back(std::stoull(w));
+      }
+      return true;
+    };
+    std::vector<unsigned long long> one;
+    static const std::vector<std::string> keys = {
+        "VERSION", "FIELDS", "SIZE", "TYPE", "COUNT", "WIDTH", "HEIGHT", "POINTS"};
+    if (std::find(keys.begin(), keys.end(), key) != keys.end() &&
+        !seen.insert(key).second)
+      return corrupt("it has two " + key + " lines");
+    if (key == "FIELDS")
+      fields = rest;
+    else if (key == "TYPE")
+      types = rest;
+    else if ((key == "SIZE" && !numbers(sizes)) || (key == "COUNT" && !numbers(counts)))
+      return corrupt("its " + key + " line is not a list of numbers");
+    else if (key == "WIDTH" || key == "HEIGHT" || key == "POINTS") {
+      if (!numbers(one) || one.size() != 1)
+        return corrupt("its " + key + " line is not one number");
+      (key == "WIDTH" ? width : key == "HEIGHT" ? height : points) = one[0];
+    }
+    else if (key == "DATA") {
+      data = rest.empty() ? "" : rest[0];
+      data_seen = true;
+    }
   }
-  if (data.empty() || sizes.empty()) {
+  if (!data_seen || fields.empty()) {
     error = "cannot read '" + path + "' as PCD: its header is missing or malformed";
     return false;
   }
-  for (std::size_t i = 0; i < sizes.size(); ++i) {
-    const unsigned long long count = i < counts.size() ? std::max(counts[i], 1ull) : 1;
-    if (sizes[i] > 8 || count > (1ull << 20)) {
-      error = "cannot read '" + path + "' as PCD: field " + std::to_string(i + 1) +
-              " has SIZE " + std::to_string(sizes[i]) + " and COUNT " +
-              std::to_string(count) + ": the header is corrupt";
-      return false;
-    }
+  if (data != "ascii" && data != "binary" && data != "binary_compressed")
+    return corrupt("DATA '" + data + "' is none of ascii, binary, binary_compressed");
+  if (sizes.size() != fields.size() || types.size() != fields.size() ||
+      (!counts.empty() && counts.size() != fields.size()))
+    return corrupt("FIELDS, SIZE, TYPE and COUNT list different numbers of fields");
+  for (std::size_t i = 0; i < fields.size(); ++i) {
+    const unsigned long long count = counts.empty() ? 1 : counts[i];
+    if ((sizes[i] != 1 && sizes[i] != 2 && sizes[i] != 4 && sizes[i] != 8) ||
+        (types[i] != "I" && types[i] != "U" && types[i] != "F") || count == 0 ||
+        count > (1ull << 20))
+      return corrupt("field " + fields[i] + " has SIZE " + std::to_string(sizes[i]) +
+                     ", TYPE " + types[i] + " and COUNT " + std::to_string(count));
     bytes_per_point += sizes[i] * count;
     values_per_point += count;
   }
-  if (width > (1ull << 40) || height > (1ull << 40) || points > (1ull << 40)) {
-    error = "cannot read '" + path + "' as PCD: its header claims an implausible " +
-            "number of points";
-    return false;
-  }
+  if (width > (1ull << 40) || height > (1ull << 40) || points > (1ull << 40))
+    return corrupt("it claims an implausible number of points");
   points = std::max(points, width * height);
   const long long data_bytes = bytesAfter(path, in.tellg());
   if (data == "binary_compressed") { // two sizes, then the compressed data
     std::uint32_t stored[2] = {0, 0};
-    if (points > 0 && !in.read(reinterpret_cast<char*>(stored), sizeof stored)) {
+    if (!in.read(reinterpret_cast<char*>(stored), sizeof stored)) {
       error = "cannot read '" + path + "': its compressed data is missing (truncated)";
       return false;
     }
@@ -184,7 +211,11 @@ pcdSizesPlausible(const std::string& path, std::string& error)
     }
     return true;
   }
-  return plausibleSize(path, points * values_per_point, data_bytes, error);
+  // Binary data is exactly the points' bytes; text takes at least a byte per value.
+  return plausibleSize(path,
+                       points * (data == "binary" ? bytes_per_point : values_per_point),
+                       data_bytes,
+                       error);
 }
 
 /** PCL 1.13's PCDReader::read crashes on some malformed headers (no fields): check the
