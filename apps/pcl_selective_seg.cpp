@@ -23,6 +23,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -160,6 +161,49 @@ parseVector(
   return true;
 }
 
+/** The same file, as far as the paths tell (symbolic links and "." resolved). */
+bool
+samePath(const std::string& a, const std::string& b)
+{
+  std::error_code ec_a, ec_b;
+  const auto ca = std::filesystem::weakly_canonical(a, ec_a);
+  const auto cb = std::filesystem::weakly_canonical(b, ec_b);
+  return !ec_a && !ec_b ? ca == cb : a == b;
+}
+
+/** Two outputs naming one file would silently keep only the last one; an output naming
+ * the input would replace the scan. */
+bool
+outputsDistinct(const Options& opt)
+{
+  const std::vector<std::pair<const char*, std::string>> outputs = {
+      {"-o", opt.labels},
+      {"-mesh_ply", opt.mesh_ply},
+      {"-mesh_vtk", opt.mesh_vtk},
+      {"-leaves", opt.leaves},
+      {"-json", opt.json}};
+  for (std::size_t i = 0; i < outputs.size(); ++i) {
+    if (outputs[i].second.empty())
+      continue;
+    if (samePath(outputs[i].second, opt.input)) {
+      print_error("Option %s names the input file '%s': give another output name.\n",
+                  outputs[i].first,
+                  opt.input.c_str());
+      return false;
+    }
+    for (std::size_t j = i + 1; j < outputs.size(); ++j)
+      if (!outputs[j].second.empty() && samePath(outputs[i].second, outputs[j].second)) {
+        print_error("Options %s and %s name the same file '%s': give each output its "
+                    "own name.\n",
+                    outputs[i].first,
+                    outputs[j].first,
+                    outputs[i].second.c_str());
+        return false;
+      }
+  }
+  return true;
+}
+
 /** \return 0 on success, else the exit code. */
 int
 parseOptions(int argc, char** argv, Options& opt)
@@ -173,6 +217,8 @@ parseOptions(int argc, char** argv, Options& opt)
   parse_argument(argc, argv, "-json", opt.json);
   parse_argument(argc, argv, "-roi_json", opt.roi_json);
   opt.ignore_viewpoint = find_switch(argc, argv, "-ignore_viewpoint");
+  if (!outputsDistinct(opt))
+    return kUsageError;
   if (!selseg_apps::parseNumber(argc, argv, "-unit_scale", opt.unit_scale) ||
       !(opt.unit_scale > 0.0) ||
       !parseVector(argc, argv, "-sensor_origin", 3, opt.sensor_origin) ||

@@ -15,11 +15,14 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <sstream>
 
 #include "segment_colors.h"
+
+#include <unistd.h>
 
 namespace selseg_apps {
 
@@ -128,12 +131,41 @@ OutputTransaction::stage(const std::string& final_path)
 bool
 OutputTransaction::commit(std::string& error)
 {
+  namespace fs = std::filesystem;
+  std::error_code ec;
   for (const auto& f : files_)
-    if (std::rename(f.first.c_str(), f.second.c_str()) != 0) {
-      error = "cannot rename '" + f.first + "' to '" + f.second +
-              "': " + std::strerror(errno);
+    if (fs::is_directory(f.second, ec)) {
+      error = "cannot write '" + f.second + "': it is a folder; give a file name";
       return false;
     }
+  // Old files of the same names are kept as hard links until every rename succeeded,
+  // so that a failure part way restores them: all outputs change, or none.
+  std::vector<std::string> backups(files_.size());
+  for (std::size_t i = 0; i < files_.size(); ++i) {
+    if (!fs::exists(files_[i].second, ec))
+      continue;
+    const std::string backup = files_[i].first + ".old";
+    std::remove(backup.c_str());
+    if (::link(files_[i].second.c_str(), backup.c_str()) == 0)
+      backups[i] = backup;
+  }
+  for (std::size_t i = 0; i < files_.size(); ++i)
+    if (std::rename(files_[i].first.c_str(), files_[i].second.c_str()) != 0) {
+      error = "cannot rename '" + files_[i].first + "' to '" + files_[i].second +
+              "': " + std::strerror(errno);
+      for (std::size_t j = 0; j < i; ++j)
+        if (backups[j].empty())
+          std::remove(files_[j].second.c_str());
+        else
+          std::rename(backups[j].c_str(), files_[j].second.c_str());
+      for (std::size_t j = i; j < files_.size(); ++j)
+        if (!backups[j].empty())
+          std::remove(backups[j].c_str());
+      return false;
+    }
+  for (const auto& b : backups)
+    if (!b.empty())
+      std::remove(b.c_str());
   committed_ = true;
   return true;
 }

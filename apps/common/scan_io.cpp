@@ -13,8 +13,12 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstring>
+#include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
+#include <vector>
 
 namespace selseg_apps {
 namespace {
@@ -39,11 +43,188 @@ hasXYZ(const pcl::PCLPointCloud2& blob)
          pcl::getFieldIndex(blob, "z") >= 0;
 }
 
+const char*
+typeName(std::uint8_t datatype)
+{
+  switch (datatype) {
+  case pcl::PCLPointField::INT8: return "int8";
+  case pcl::PCLPointField::UINT8: return "uint8";
+  case pcl::PCLPointField::INT16: return "int16";
+  case pcl::PCLPointField::UINT16: return "uint16";
+  case pcl::PCLPointField::INT32: return "int32";
+  case pcl::PCLPointField::UINT32: return "uint32";
+  case pcl::PCLPointField::FLOAT32: return "float32";
+  case pcl::PCLPointField::FLOAT64: return "float64";
+  default: return "unknown";
+  }
+}
+
+/** x, y and z must each be one float32 or float64 value: anything else would be read
+ * as garbage (PCL's conversion leaves a field of another type at zero). */
+bool
+coordinateFieldsUsable(const std::string& path,
+                       const pcl::PCLPointCloud2& blob,
+                       std::string& error)
+{
+  if (!hasXYZ(blob)) {
+    error = "'" + path + "' has no x, y and z fields: give a cloud of 3-D points";
+    return false;
+  }
+  for (const char* name : {"x", "y", "z"}) {
+    const auto& f = blob.fields[pcl::getFieldIndex(blob, name)];
+    if ((f.datatype != pcl::PCLPointField::FLOAT32 &&
+         f.datatype != pcl::PCLPointField::FLOAT64) ||
+        f.count != 1) {
+      error = "'" + path + "': field " + name + " holds " + std::to_string(f.count) +
+              " value(s) of type " + typeName(f.datatype) +
+              "; x, y and z must each be one float32 or float64 value (PCD: SIZE 4 or "
+              "8, TYPE F, COUNT 1)";
+      return false;
+    }
+  }
+  return true;
+}
+
+/** The bytes after position \a from in the file, or -1. */
+long long
+bytesAfter(const std::string& path, unsigned long long from)
+{
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(path, ec);
+  if (ec)
+    return -1;
+  return size >= from ? static_cast<long long>(size - from) : -1;
+}
+
+/** A header's claims against the file's size: \a values is the least number of bytes
+ * the data it declares can take; a header promising more than the file holds is
+ * truncated or corrupt, and must not make us allocate what it claims. */
+bool
+plausibleSize(const std::string& path,
+              unsigned long long values,
+              long long data_bytes,
+              std::string& error)
+{
+  if (data_bytes >= 0 && values <= static_cast<unsigned long long>(data_bytes))
+    return true;
+  error = "cannot read '" + path + "': its header promises at least " +
+          std::to_string(values) + " bytes of data but the file holds only " +
+          std::to_string(std::max<long long>(data_bytes, 0)) +
+          ": the file is truncated or corrupt";
+  return false;
+}
+
+/** The sizes a PCD header claims, read without PCL: PCL 1.13's readHeader already
+ * allocates the data block the header claims, however large. */
+bool
+pcdSizesPlausible(const std::string& path, std::string& error)
+{
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  unsigned long long width = 0, height = 1, points = 0, bytes_per_point = 0,
+                     values_per_point = 0;
+  std::vector<std::string> fields, types;
+  std::vector<unsigned long long> sizes, counts;
+  std::string data;
+  bool data_seen = false;
+  std::set<std::string> seen;
+  const auto corrupt = [&](const std::string& why) {
+    error = "cannot read '" + path + "' as PCD: " + why + ": the header is corrupt";
+    return false;
+  };
+  while (!data_seen && std::getline(in, line)) {
+    std::istringstream words(line);
+    std::string key, word;
+    words >> key;
+    std::vector<std::string> rest;
+    while (words >> word)
+      rest.push_back(word);
+    const auto numbers = [&](std::vector<unsigned long long>& out) {
+      for (const auto& w : rest) {
+        if (w.empty() || w.find_first_not_of("0123456789") != std::string::npos ||
+            w.size() > 12)
+          return false;
+        out.push_back(std::stoull(w));
+      }
+      return true;
+    };
+    std::vector<unsigned long long> one;
+    static const std::vector<std::string> keys = {
+        "VERSION", "FIELDS", "SIZE", "TYPE", "COUNT", "WIDTH", "HEIGHT", "POINTS"};
+    if (std::find(keys.begin(), keys.end(), key) != keys.end() &&
+        !seen.insert(key).second)
+      return corrupt("it has two " + key + " lines");
+    if (key == "FIELDS")
+      fields = rest;
+    else if (key == "TYPE")
+      types = rest;
+    else if ((key == "SIZE" && !numbers(sizes)) || (key == "COUNT" && !numbers(counts)))
+      return corrupt("its " + key + " line is not a list of numbers");
+    else if (key == "WIDTH" || key == "HEIGHT" || key == "POINTS") {
+      if (!numbers(one) || one.size() != 1)
+        return corrupt("its " + key + " line is not one number");
+      (key == "WIDTH" ? width : key == "HEIGHT" ? height : points) = one[0];
+    }
+    else if (key == "DATA") {
+      data = rest.empty() ? "" : rest[0];
+      data_seen = true;
+    }
+  }
+  if (!data_seen || fields.empty()) {
+    error = "cannot read '" + path + "' as PCD: its header is missing or malformed";
+    return false;
+  }
+  if (data != "ascii" && data != "binary" && data != "binary_compressed")
+    return corrupt("DATA '" + data + "' is none of ascii, binary, binary_compressed");
+  if (sizes.size() != fields.size() || types.size() != fields.size() ||
+      (!counts.empty() && counts.size() != fields.size()))
+    return corrupt("FIELDS, SIZE, TYPE and COUNT list different numbers of fields");
+  for (std::size_t i = 0; i < fields.size(); ++i) {
+    const unsigned long long count = counts.empty() ? 1 : counts[i];
+    if ((sizes[i] != 1 && sizes[i] != 2 && sizes[i] != 4 && sizes[i] != 8) ||
+        (types[i] != "I" && types[i] != "U" && types[i] != "F") || count == 0 ||
+        count > (1ull << 20))
+      return corrupt("field " + fields[i] + " has SIZE " + std::to_string(sizes[i]) +
+                     ", TYPE " + types[i] + " and COUNT " + std::to_string(count));
+    bytes_per_point += sizes[i] * count;
+    values_per_point += count;
+  }
+  if (width > (1ull << 40) || height > (1ull << 40) || points > (1ull << 40))
+    return corrupt("it claims an implausible number of points");
+  points = std::max(points, width * height);
+  const long long data_bytes = bytesAfter(path, in.tellg());
+  if (data == "binary_compressed") { // two sizes, then the compressed data
+    std::uint32_t stored[2] = {0, 0};
+    if (!in.read(reinterpret_cast<char*>(stored), sizeof stored)) {
+      error = "cannot read '" + path + "': its compressed data is missing (truncated)";
+      return false;
+    }
+    // LZF expands at most about 100 times: a larger claim is corrupt.
+    if (!plausibleSize(path, stored[0] + 8ull, data_bytes, error) ||
+        !plausibleSize(path, stored[1] / 100ull, data_bytes, error))
+      return false;
+    if (stored[1] != points * bytes_per_point) {
+      error = "cannot read '" + path + "': its compressed data holds " +
+              std::to_string(stored[1]) + " bytes where the header promises " +
+              std::to_string(points * bytes_per_point) + ": the file is corrupt";
+      return false;
+    }
+    return true;
+  }
+  // Binary data is exactly the points' bytes; text takes at least a byte per value.
+  return plausibleSize(path,
+                       points * (data == "binary" ? bytes_per_point : values_per_point),
+                       data_bytes,
+                       error);
+}
+
 /** PCL 1.13's PCDReader::read crashes on some malformed headers (no fields): check the
  * header first. */
 bool
 pcdHeaderUsable(const std::string& path, std::string& error)
 {
+  if (!pcdSizesPlausible(path, error))
+    return false;
   pcl::PCLPointCloud2 header;
   Eigen::Vector4f origin;
   Eigen::Quaternionf orientation;
@@ -55,10 +236,84 @@ pcdHeaderUsable(const std::string& path, std::string& error)
     error = "cannot read '" + path + "' as PCD: its header is missing or malformed";
     return false;
   }
-  if (!hasXYZ(header)) {
-    error = "'" + path + "' has no x, y and z fields: give a cloud of 3-D points";
+  return coordinateFieldsUsable(path, header, error);
+}
+
+/** Counts the values the vertex element of a PLY header promises. */
+bool
+plyHeaderUsable(const std::string& path, std::string& error)
+{
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  if (!std::getline(in, line) || line.compare(0, 3, "ply") != 0) {
+    error = "cannot read '" + path + "' as PLY: it does not start with 'ply'";
     return false;
   }
+  unsigned long long values = 0, count = 0;
+  bool in_element = false;
+  while (std::getline(in, line)) {
+    std::istringstream words(line);
+    std::string keyword;
+    words >> keyword;
+    if (keyword == "end_header")
+      return plausibleSize(path, values, bytesAfter(path, in.tellg()), error);
+    if (keyword == "element") {
+      std::string name;
+      words >> name >> count;
+      if (!words) {
+        error = "cannot read '" + path + "' as PLY: malformed line '" + line + "'";
+        return false;
+      }
+      in_element = true;
+    }
+    else if (keyword == "property" && in_element) {
+      if (count > (1ull << 40)) {
+        error = "cannot read '" + path + "' as PLY: element count " +
+                std::to_string(count) + " is not plausible";
+        return false;
+      }
+      values += count;
+    }
+  }
+  error = "cannot read '" + path + "' as PLY: its header has no end_header (truncated)";
+  return false;
+}
+
+/** x, y, z of every point of \a blob, converted from float32 or float64. */
+bool
+extractXYZ(const std::string& path,
+           const pcl::PCLPointCloud2& blob,
+           pcl::PointCloud<pcl::PointXYZ>& cloud,
+           std::string& error)
+{
+  if (!coordinateFieldsUsable(path, blob, error))
+    return false;
+  const std::size_t points = static_cast<std::size_t>(blob.width) * blob.height;
+  const pcl::PCLPointField* fields[3];
+  for (int k = 0; k < 3; ++k) {
+    fields[k] = &blob.fields[pcl::getFieldIndex(blob, k == 0 ? "x" : k == 1 ? "y" : "z")];
+    const std::size_t size = fields[k]->datatype == pcl::PCLPointField::FLOAT64 ? 8 : 4;
+    if (fields[k]->offset + size > blob.point_step ||
+        (points > 0 && blob.data.size() < points * blob.point_step)) {
+      error = "cannot read '" + path + "': its fields do not fit in its points (corrupt)";
+      return false;
+    }
+  }
+  cloud.resize(points);
+  cloud.width = blob.width;
+  cloud.height = blob.height;
+  cloud.is_dense = false;
+  for (std::size_t i = 0; i < points; ++i)
+    for (int k = 0; k < 3; ++k) {
+      const std::uint8_t* at = blob.data.data() + i * blob.point_step + fields[k]->offset;
+      if (fields[k]->datatype == pcl::PCLPointField::FLOAT64) {
+        double v;
+        std::memcpy(&v, at, sizeof v);
+        cloud[i].data[k] = static_cast<float>(v);
+      }
+      else
+        std::memcpy(&cloud[i].data[k], at, sizeof(float));
+    }
   return true;
 }
 
@@ -72,21 +327,22 @@ loadBinaryFormat(const std::string& path,
   Eigen::Vector4f origin = Eigen::Vector4f::Zero();
   Eigen::Quaternionf orientation = Eigen::Quaternionf::Identity();
   int version = 0;
-  if (ext == ".pcd" && !pcdHeaderUsable(path, error))
+  if (ext == ".pcd" ? !pcdHeaderUsable(path, error) : !plyHeaderUsable(path, error))
     return false;
-  const int rc = ext == ".pcd"
-                     ? pcl::PCDReader().read(path, blob, origin, orientation, version)
-                     : pcl::PLYReader().read(path, blob, origin, orientation, version);
+  int rc = -1;
+  try {
+    rc = ext == ".pcd" ? pcl::PCDReader().read(path, blob, origin, orientation, version)
+                       : pcl::PLYReader().read(path, blob, origin, orientation, version);
+  } catch (const std::exception& e) { // PCL's readers throw on some corrupt files
+    rc = -1;
+  }
   if (rc < 0) {
     error = "cannot read '" + path + "' as " + (ext == ".pcd" ? "PCD" : "PLY") +
             ": check that the file exists, is readable and is not truncated";
     return false;
   }
-  if (!hasXYZ(blob)) {
-    error = "'" + path + "' has no x, y and z fields: give a cloud of 3-D points";
+  if (!extractXYZ(path, blob, cloud, error))
     return false;
-  }
-  pcl::fromPCLPointCloud2(blob, cloud);
   cloud.sensor_origin_ = origin;
   cloud.sensor_orientation_ = orientation;
   return true;
@@ -134,12 +390,27 @@ loadScan(const std::string& path,
          std::string& error)
 {
   cloud.clear();
-  const std::string ext = lowerExtension(path);
-  const bool ok = (ext == ".pcd" || ext == ".ply")
-                      ? loadBinaryFormat(path, ext, cloud, error)
-                      : loadText(path, cloud, error);
-  if (!ok)
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    error = "cannot read '" + path + "': it does not exist or is not a regular file";
     return false;
+  }
+  const std::string ext = lowerExtension(path);
+  bool ok = false;
+  try {
+    ok = (ext == ".pcd" || ext == ".ply") ? loadBinaryFormat(path, ext, cloud, error)
+                                          : loadText(path, cloud, error);
+  } catch (const std::bad_alloc&) {
+    error = "cannot read '" + path + "': not enough memory for what it declares";
+    ok = false;
+  } catch (const std::exception& e) {
+    error = "cannot read '" + path + "': " + e.what();
+    ok = false;
+  }
+  if (!ok) {
+    cloud.clear();
+    return false;
+  }
   if (unit_scale != 1.0)
     for (auto& p : cloud)
       p.getVector3fMap() *= static_cast<float>(unit_scale);

@@ -61,6 +61,21 @@ SelectiveSegmentationParameters::validate(std::string* why) const
         why, "angle_quantization [rad]", angle_quantization, "[2.5e-8, 1e-2]");
   if (num_threads < 0 || num_threads > 1024)
     return reject(why, "num_threads", num_threads, "[0, 1024], 0 = all cores");
+  if (edge_triangle_normal != EdgeTriangleNormal::Facet &&
+      edge_triangle_normal != EdgeTriangleNormal::VertexMean)
+    return reject(why,
+                  "edge_triangle_normal",
+                  static_cast<int>(edge_triangle_normal),
+                  "facet or vertex_mean (EdgeTriangleNormal 0 or 1)");
+  if (delaunay_backend != DelaunayBackend::BoostVoronoi &&
+      delaunay_backend != DelaunayBackend::Vtk &&
+      delaunay_backend != DelaunayBackend::Sweep)
+    return reject(why,
+                  "delaunay_backend",
+                  static_cast<int>(delaunay_backend),
+                  isDelaunayBackendAvailable(DelaunayBackend::Vtk)
+                      ? "sweep, boost or vtk (DelaunayBackend 2, 0 or 1)"
+                      : "sweep, boost (DelaunayBackend 2, 0; vtk needs a build with VTK)");
   if (!isDelaunayBackendAvailable(delaunay_backend)) {
     if (why)
       *why = std::string("parameter delaunay_backend = ") + toString(delaunay_backend) +

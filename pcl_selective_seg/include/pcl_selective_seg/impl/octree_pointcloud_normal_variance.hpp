@@ -101,6 +101,11 @@ OctreePointCloudNormalVariance<PointT>::addPointsFromInputCloud()
     lo = lo.min(p);
     hi = hi.max(p);
   }
+  // PCL's octree subtracts FLT_EPSILON (absolute) from each side of the box before
+  // counting voxels: a narrower side (a scene smaller than 0.1 micrometre, or flat
+  // along an axis with voxels under 12 micrometres) gave a negative count cast to an
+  // unsigned integer. Make every side at least 2 FLT_EPSILON wide.
+  hi = hi.max(lo + 2.0 * std::numeric_limits<float>::epsilon());
   // Pad the top so that no point sits exactly on the box's upper faces.
   hi += 0.01 * this->resolution_;
   this->defineBoundingBox(lo.x(), lo.y(), lo.z(), hi.x(), hi.y(), hi.z());

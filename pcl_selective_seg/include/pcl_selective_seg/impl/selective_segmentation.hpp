@@ -87,6 +87,40 @@ SelectiveSegmentation<PointT>::triangulate()
                 "the " + std::to_string(tri.vertex_point.size()) +
                     " distinct viewing directions are fewer than three or all on one "
                     "line in (theta, phi): there is no surface to triangulate");
+  // Points on one 3-D line that misses the sensor have distinct directions and are
+  // triangulated, but their triangles' areas are float rounding: any segment would be
+  // noise. The line through vertex 0 and the vertex farthest from it must leave some
+  // vertex by more than a few float roundings of the coordinates. (An exact test:
+  // a far outlier cannot make a surface look like a line, as a principal axis would.)
+  const auto& pos = tri.vertex_positions;
+  const Eigen::Vector3d a = pos[0].template cast<double>();
+  std::size_t far = 0;
+  double far_distance = 0.0;
+  for (std::size_t v = 1; v < pos.size(); ++v) {
+    const double d = (pos[v].template cast<double>() - a).squaredNorm();
+    if (d > far_distance) {
+      far = v;
+      far_distance = d;
+    }
+  }
+  const Eigen::Vector3d b = pos[far].template cast<double>();
+  const double length = std::sqrt(far_distance);
+  const Eigen::Vector3d axis = (b - a) / length;
+  const double tolerance = 16.0 * std::numeric_limits<float>::epsilon();
+  bool on_line = far_distance > 0.0;
+  for (std::size_t v = 1; on_line && v < pos.size(); ++v) {
+    const Eigen::Vector3d p = pos[v].template cast<double>();
+    const Eigen::Vector3d off = (p - a) - axis * axis.dot(p - a);
+    // The rounding of p, and that of a and b carried to p along the line.
+    const double rounding =
+        p.norm() + (a.norm() * (p - b).norm() + b.norm() * (p - a).norm()) / length;
+    on_line = off.norm() <= tolerance * rounding;
+  }
+  if (on_line)
+    return fail("extract",
+                "the " + std::to_string(pos.size()) +
+                    " distinct points lie on one line in 3-D (to float precision): "
+                    "there is no surface to segment");
   return true;
 }
 
@@ -179,11 +213,18 @@ SelectiveSegmentation<PointT>::buildOctree()
   }
   // The finest voxel: the parameter, or a multiple of the point spacing, but never so
   // small that the tree would exceed its maximum depth.
-  const double extent = (hi - lo).template cast<double>().maxCoeff();
+  // In double: the difference of two floats near float's limits overflows float.
+  const double extent =
+      (hi.template cast<double>() - lo.template cast<double>()).maxCoeff();
   double resolution = params_.min_voxel_size > 0.0
                           ? params_.min_voxel_size
                           : params_.min_voxel_size_factor * result_.median_spacing;
-  resolution = std::max(resolution, extent / std::ldexp(1.0, params_.max_octree_depth));
+  // 2^depth - 1 voxels: the octree pads its box by a hundredth of a voxel, which must
+  // not take it one level deeper than max_octree_depth. The box is at least 2 float
+  // epsilons wide (OctreePointCloudNormalVariance: PCL's octree subtracts one).
+  const double box = std::max(extent, 2.0 * std::numeric_limits<float>::epsilon());
+  resolution =
+      std::max(resolution, box / (std::ldexp(1.0, params_.max_octree_depth) - 1.0));
   if (!(resolution > 0.0) || !std::isfinite(resolution))
     resolution = extent > 0.0 && std::isfinite(extent) ? extent : 1.0;
   result_.min_voxel_size = resolution;

@@ -1,0 +1,215 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
+ */
+
+// libFuzzer target: SelectiveSegmentation::extract() on arbitrary points, parameters
+// and sensor poses. Beyond crashes, hangs and sanitizer findings it aborts on garbage:
+// an accepted invalid parameter, a refused valid one on a usable cloud, or a result
+// whose labels, counts, clusters and mesh disagree.
+//
+// Input layout (all little endian; missing bytes read as zero):
+//   byte 0        point encoding: 0 raw float32 x y z; 1 int8 grid (x/16, y/16,
+//                 1 + z/16); 2 int16 grid (/1024, z shifted to 1 + z/1024); 3 float32 x y
+//                 and a range (a direction plus depth: many points per ray)
+//   byte 1        which parameters to override (bit i: parameter i below)
+//   bytes 2-3     sensor pose: 0 = identity, else a quaternion and origin from bytes
+//   then          13 parameter slots of 8 bytes (double, or int in the low 4 bytes)
+//   then          the points
+
+#include <pcl_selective_seg/selective_segmentation.h>
+
+#include <pcl/console/print.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+
+namespace {
+
+using pcl::selective_seg::SelectiveSegmentation;
+using pcl::selective_seg::SelectiveSegmentationParameters;
+
+struct Reader {
+  const std::uint8_t* data;
+  std::size_t size;
+  std::size_t at = 0;
+  template <typename T>
+  T
+  get()
+  {
+    T value{};
+    unsigned char bytes[sizeof(T)] = {};
+    for (std::size_t i = 0; i < sizeof(T) && at < size; ++i)
+      bytes[i] = data[at++];
+    std::memcpy(&value, bytes, sizeof(T));
+    return value;
+  }
+  std::size_t
+  left() const
+  {
+    return size - at;
+  }
+};
+
+void
+check(bool condition, const char* what)
+{
+  if (!condition) {
+    std::fprintf(stderr, "fuzz_segmentation: invariant violated: %s\n", what);
+    std::abort();
+  }
+}
+
+} // namespace
+
+extern "C" int
+LLVMFuzzerInitialize(int*, char***)
+{
+  pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);
+  return 0;
+}
+
+extern "C" int
+LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size)
+{
+  Reader in{data, size};
+  const std::uint8_t encoding = in.get<std::uint8_t>() % 4;
+  const std::uint8_t overrides = in.get<std::uint8_t>();
+  const std::uint16_t pose_bytes = in.get<std::uint16_t>();
+
+  SelectiveSegmentationParameters p;
+  std::uint64_t slot[13];
+  for (auto& s : slot)
+    s = in.get<std::uint64_t>();
+  const auto dbl = [&](int i) {
+    double v;
+    std::memcpy(&v, &slot[i], sizeof v);
+    return v;
+  };
+  const auto i32 = [&](int i) { return static_cast<std::int32_t>(slot[i]); };
+  // Bit 0..7 of the override byte choose among the parameters; the rest of the slots
+  // act only when the byte says "all" (0xff), to keep many inputs at the defaults.
+  if (overrides & 1)
+    p.max_normal_std_dev = dbl(0);
+  if (overrides & 2)
+    p.max_merge_angle = dbl(1);
+  if (overrides & 4)
+    p.max_edge_triangle_angle = dbl(2);
+  if (overrides & 8)
+    p.max_view_incidence_angle = dbl(3);
+  if (overrides & 16)
+    p.normal_rings = i32(4);
+  if (overrides & 32)
+    p.min_voxel_size = dbl(5);
+  if (overrides & 64)
+    p.min_points_to_split = i32(6);
+  if (overrides & 128)
+    p.max_octree_depth = i32(7);
+  if (overrides == 0xff) {
+    p.min_voxel_size_factor = dbl(8);
+    p.angle_quantization = dbl(9);
+    p.num_threads = i32(10) % 4; // valid 0-3 or invalid negatives: no thread storms
+    p.edge_triangle_normal =
+        static_cast<pcl::selective_seg::EdgeTriangleNormal>(slot[11] & 0xff);
+    p.delaunay_backend = static_cast<pcl::selective_seg::DelaunayBackend>(slot[12] & 0xff);
+  }
+  else {
+    p.edge_triangle_normal =
+        static_cast<pcl::selective_seg::EdgeTriangleNormal>(slot[11] & 1);
+    if (slot[12] & 1)
+      p.delaunay_backend = pcl::selective_seg::DelaunayBackend::BoostVoronoi;
+  }
+  // The vtk backend is not under test here (third-party floating point code).
+  if (p.delaunay_backend == pcl::selective_seg::DelaunayBackend::Vtk)
+    p.delaunay_backend = pcl::selective_seg::DelaunayBackend::Sweep;
+  const bool valid = p.validate();
+
+  auto cloud = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  const std::size_t stride = encoding == 1 ? 3 : encoding == 2 ? 6 : 12;
+  while (in.left() >= stride) {
+    pcl::PointXYZ q;
+    switch (encoding) {
+    case 0:
+      q.x = in.get<float>();
+      q.y = in.get<float>();
+      q.z = in.get<float>();
+      break;
+    case 1:
+      q.x = in.get<std::int8_t>() / 16.0f;
+      q.y = in.get<std::int8_t>() / 16.0f;
+      q.z = 1.0f + in.get<std::int8_t>() / 16.0f;
+      break;
+    case 2:
+      q.x = in.get<std::int16_t>() / 1024.0f;
+      q.y = in.get<std::int16_t>() / 1024.0f;
+      q.z = 1.0f + in.get<std::int16_t>() / 1024.0f;
+      break;
+    default: {
+      const float dx = in.get<float>(), dy = in.get<float>(), r = in.get<float>();
+      q.x = dx * r;
+      q.y = dy * r;
+      q.z = r;
+    }
+    }
+    cloud->push_back(q);
+  }
+  cloud->is_dense = false;
+
+  SelectiveSegmentation<pcl::PointXYZ> seg;
+  seg.setParameters(p);
+  if (pose_bytes != 0) {
+    Eigen::Affine3f pose = Eigen::Affine3f::Identity();
+    const Eigen::Quaternionf q(1.0f,
+                               (pose_bytes & 0xf) / 8.0f - 1.0f,
+                               ((pose_bytes >> 4) & 0xf) / 8.0f - 1.0f,
+                               ((pose_bytes >> 8) & 0xf) / 8.0f - 1.0f);
+    pose.linear() = q.normalized().toRotationMatrix();
+    pose.translation() = Eigen::Vector3f(0.0f, 0.0f, ((pose_bytes >> 12) & 0xf) - 8.0f);
+    seg.setSensorPose(pose);
+  }
+  seg.setInputCloud(cloud);
+  std::vector<pcl::PointIndices> clusters;
+  const bool ok = seg.extract(clusters);
+  check(valid || !ok, "extract() accepted invalid parameters");
+  if (!ok) {
+    check(clusters.empty(), "failed extract() left clusters");
+    check(!seg.getLabeledCloud(), "failed extract() left a labeled cloud");
+    return 0;
+  }
+  const auto& r = seg.getResult();
+  check(r.labels.size() == cloud->size(), "labels not one per point");
+  check(!r.segments.empty() && clusters.size() == r.segments.size(),
+        "clusters and segments disagree");
+  std::size_t labeled = 0;
+  for (const auto l : r.labels) {
+    check(l <= r.segments.size(), "label out of range");
+    labeled += l > 0;
+  }
+  const auto& c = r.counts;
+  check(c.labeled == labeled, "labeled count wrong");
+  check(c.labeled + c.without_normal + c.non_finite + c.behind_sensor +
+                c.outside_indices ==
+            cloud->size(),
+        "counts do not add up to the points");
+  std::size_t in_clusters = 0;
+  for (std::size_t s = 0; s < clusters.size(); ++s) {
+    check(!clusters[s].indices.empty(), "empty segment");
+    check(clusters[s].indices.size() == r.segments[s].num_points, "segment size");
+    for (const auto i : clusters[s].indices)
+      check(r.labels[i] == s + 1, "cluster and label disagree");
+    in_clusters += clusters[s].indices.size();
+    check(r.segments[s].normal.allFinite(), "segment normal not finite");
+  }
+  check(in_clusters == labeled, "clusters miss labeled points");
+  for (const auto& t : r.mesh.triangles)
+    for (const auto v : t)
+      check(v >= 0 && static_cast<std::size_t>(v) < cloud->size(), "mesh index");
+  for (const auto& leaf : r.leaves)
+    check(leaf.label >= 1 && leaf.label <= r.segments.size() && leaf.normal.allFinite(),
+          "leaf label or normal");
+  check(std::isfinite(r.min_voxel_size) && r.min_voxel_size > 0.0, "voxel size");
+  return 0;
+}

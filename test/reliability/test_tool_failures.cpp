@@ -1,0 +1,356 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
+ */
+
+// The tool on broken inputs and broken output locations: truncated or corrupt files,
+// lying headers, wrong field types, unwritable folders, a full disk (a file size limit,
+// RLIMIT_FSIZE, in the child). Each gives a message saying what is wrong, exit code 1
+// (2 for usage errors), and no output: neither a partial file nor a changed old one.
+// Arguments: the tool's path, then the bundled scan.
+
+#include <gtest/gtest.h>
+#include <pcl/io/pcd_io.h>
+#include <pcl/io/ply_io.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <sys/resource.h>
+#include <sys/wait.h>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string tool; // NOLINT: set once in main()
+std::string scan; // NOLINT: set once in main()
+
+struct Outcome {
+  int code = -1;        ///< exit code, -1 when killed by a signal
+  std::string messages; ///< stdout and stderr
+};
+
+/** Run the tool with \a args, optionally under a file size limit [KiB]. */
+Outcome
+run(const std::string& args, long file_size_limit_kib = -1)
+{
+  std::string command = "'" + tool + "' " + args;
+  if (file_size_limit_kib >= 0)
+    command = "bash -c \"ulimit -f " + std::to_string(file_size_limit_kib) +
+              "; trap '' XFSZ; exec " + command + "\"";
+  Outcome o;
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+  if (!pipe)
+    return o;
+  char buffer[4096];
+  std::size_t n;
+  while ((n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0)
+    o.messages.append(buffer, n);
+  const int status = pclose(pipe);
+  o.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return o;
+}
+
+std::string
+shellQuoted(const fs::path& p)
+{
+  return "'" + p.string() + "'";
+}
+
+void
+writeFile(const fs::path& path, const std::string& content)
+{
+  std::ofstream(path, std::ios::binary) << content;
+}
+
+std::string
+readFile(const fs::path& path)
+{
+  std::ifstream in(path, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), {});
+}
+
+/** A 40 x 30 wall at 1 m, centred on the optical axis. */
+pcl::PointCloud<pcl::PointXYZ>
+wall()
+{
+  pcl::PointCloud<pcl::PointXYZ> cloud(40, 30);
+  for (int r = 0; r < 30; ++r)
+    for (int c = 0; c < 40; ++c)
+      cloud.at(c, r) = pcl::PointXYZ(0.01f * (c - 20), 0.01f * (r - 15), 1.0f);
+  return cloud;
+}
+
+/** A PCD header for the wall with the given field declarations. */
+std::string
+pcdHeader(const std::string& fields,
+          const std::string& sizes,
+          const std::string& types,
+          const std::string& counts,
+          std::size_t points,
+          const std::string& data)
+{
+  std::ostringstream h;
+  h << "# .PCD v0.7\nVERSION 0.7\nFIELDS " << fields << "\nSIZE " << sizes << "\nTYPE "
+    << types << "\nCOUNT " << counts << "\nWIDTH " << points
+    << "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " << points << "\nDATA " << data
+    << "\n";
+  return h.str();
+}
+
+class ToolFailure : public ::testing::Test {
+protected:
+  void
+  SetUp() override
+  {
+    if (tool.empty() || !fs::exists(tool) || !fs::exists(scan))
+      GTEST_SKIP() << "tool or scan missing";
+    dir = fs::temp_directory_path() /
+          ("selseg_failure_" +
+           std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    fs::remove_all(dir);
+    fs::create_directories(dir / "in");
+    fs::create_directories(dir / "out");
+  }
+  void
+  TearDown() override
+  {
+    fs::remove_all(dir);
+  }
+  /** Files in out/ (outputs, temporaries, leftovers). */
+  std::vector<std::string>
+  outputs() const
+  {
+    std::vector<std::string> names;
+    for (const auto& e : fs::directory_iterator(dir / "out"))
+      names.push_back(e.path().filename().string());
+    return names;
+  }
+  /** Every output option, into out/. */
+  std::string
+  allOutputs() const
+  {
+    const fs::path o = dir / "out";
+    return " -o " + shellQuoted(o / "labels.pcd") + " -mesh_ply " + shellQuoted(o / "mesh.ply") +
+           " -mesh_vtk " + shellQuoted(o / "mesh.vtk") + " -leaves " +
+           shellQuoted(o / "leaves.pcd") + " -json " + shellQuoted(o / "summary.json");
+  }
+  /** The tool must fail on \a input with exit code 1, say \a why, write nothing. */
+  void
+  expectRejected(const fs::path& input, const std::string& why)
+  {
+    const Outcome o = run(shellQuoted(input) + " -ignore_viewpoint" + allOutputs());
+    EXPECT_EQ(o.code, 1) << input << ": " << o.messages;
+    EXPECT_NE(o.messages.find(why), std::string::npos)
+        << input << ": expected '" << why << "' in: " << o.messages;
+    EXPECT_TRUE(outputs().empty()) << input;
+  }
+  fs::path dir;
+};
+
+} // namespace
+
+TEST_F(ToolFailure, TruncatedFilesAreRejected)
+{
+  const auto cloud = wall();
+  const fs::path in = dir / "in";
+  pcl::io::savePCDFileBinary((in / "binary.pcd").string(), cloud);
+  pcl::io::savePCDFileBinaryCompressed((in / "compressed.pcd").string(), cloud);
+  pcl::io::savePCDFileASCII((in / "ascii.pcd").string(), cloud);
+  pcl::io::savePLYFileBinary((in / "binary.ply").string(), cloud);
+  pcl::io::savePLYFileASCII((in / "ascii.ply").string(), cloud);
+  fs::copy_file(scan, in / "scan.pcd");
+  for (const char* name :
+       {"binary.pcd", "compressed.pcd", "ascii.pcd", "binary.ply", "ascii.ply", "scan.pcd"}) {
+    const std::string full = readFile(in / name);
+    // Cut in the data (two thirds) and in the header (40 bytes).
+    for (const std::size_t keep : {full.size() * 2 / 3, std::size_t(40)}) {
+      writeFile(in / ("cut_" + std::to_string(keep) + "_" + name), full.substr(0, keep));
+      expectRejected(in / ("cut_" + std::to_string(keep) + "_" + name), "cannot read");
+    }
+  }
+}
+
+TEST_F(ToolFailure, CorruptFilesAreRejected)
+{
+  const fs::path in = dir / "in";
+  const std::string xyz = pcdHeader("x y z", "4 4 4", "F F F", "1 1 1", 3, "ascii");
+  // The header promises more points than the data holds.
+  writeFile(in / "short_ascii.pcd", xyz + "0 0 1\n1 0 1\n");
+  expectRejected(in / "short_ascii.pcd", "cannot read");
+  // A header claiming four billion points, with no data: no huge allocation.
+  writeFile(in / "huge.pcd",
+            pcdHeader("x y z", "4 4 4", "F F F", "1 1 1", 4000000000u, "binary"));
+  expectRejected(in / "huge.pcd", "cannot read");
+  writeFile(in / "huge_compressed.pcd",
+            pcdHeader("x y z", "4 4 4", "F F F", "1 1 1", 4000000000u, "binary_compressed") +
+                std::string("\x10\0\0\0\xff\xff\xff\x7f", 8) + std::string(16, 'A'));
+  expectRejected(in / "huge_compressed.pcd", "cannot read");
+  // Compressed data whose sizes disagree with the header.
+  writeFile(in / "bad_compressed.pcd",
+            pcdHeader("x y z", "4 4 4", "F F F", "1 1 1", 3, "binary_compressed") +
+                std::string("\x04\0\0\0\x24\0\0\0garbage", 15));
+  expectRejected(in / "bad_compressed.pcd", "cannot read");
+  // Not a point cloud at all, under each extension.
+  std::string noise(5000, '\0');
+  for (std::size_t i = 0; i < noise.size(); ++i)
+    noise[i] = static_cast<char>((i * 2654435761u) >> 13);
+  for (const char* name : {"noise.pcd", "noise.ply", "noise.xyz"}) {
+    writeFile(in / name, noise);
+    expectRejected(in / name, "'");
+  }
+  for (const char* name : {"empty.pcd", "empty.ply", "empty.xyz"}) {
+    writeFile(in / name, "");
+    expectRejected(in / name, "'");
+  }
+  // Text: a word among the numbers, a number beyond float's range.
+  writeFile(in / "word.xyz", "0 0 1\n0.1 0 1\n0.1 zero 1\n");
+  expectRejected(in / "word.xyz", "line 3");
+  writeFile(in / "overflow.xyz", "0 0 1\n0.1 0 1e60\n");
+  expectRejected(in / "overflow.xyz", "line 2");
+  // A folder, and a missing file.
+  expectRejected(in, "cannot");
+  expectRejected(in / "missing.pcd", "cannot read");
+}
+
+// x y z stored as doubles are read as such, not left at zero; types that are not
+// coordinates are refused with a message naming the field.
+TEST_F(ToolFailure, FieldTypesAreCheckedOrConverted)
+{
+  const fs::path in = dir / "in";
+  const auto cloud = wall();
+  std::ostringstream doubles;
+  doubles.precision(17);
+  doubles << pcdHeader("x y z", "8 8 8", "F F F", "1 1 1", cloud.size(), "ascii");
+  for (const auto& p : cloud)
+    doubles << p.x << " " << p.y << " " << p.z << "\n";
+  writeFile(in / "doubles.pcd", doubles.str());
+  const fs::path labels = dir / "out" / "labels.pcd";
+  const Outcome o = run(shellQuoted(in / "doubles.pcd") + " -ignore_viewpoint -o " + shellQuoted(labels));
+  ASSERT_EQ(o.code, 0) << o.messages;
+  pcl::PointCloud<pcl::PointXYZL> labeled;
+  ASSERT_EQ(pcl::io::loadPCDFile(labels.string(), labeled), 0);
+  ASSERT_EQ(labeled.size(), cloud.size());
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    ASSERT_EQ(labeled[i].getVector3fMap(), cloud[i].getVector3fMap()) << i;
+    ASSERT_EQ(labeled[i].label, 1u) << i;
+  }
+  fs::remove(labels);
+
+  std::ostringstream bytes;
+  bytes << pcdHeader("x y z", "1 1 1", "U U U", "1 1 1", cloud.size(), "ascii");
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    bytes << i % 7 << " " << i % 5 << " 1\n";
+  writeFile(in / "bytes.pcd", bytes.str());
+  expectRejected(in / "bytes.pcd", "field x");
+
+  std::ostringstream vector_x;
+  vector_x << pcdHeader("x y z", "4 4 4", "F F F", "2 1 1", cloud.size(), "ascii");
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    vector_x << "0 0 0 1\n";
+  writeFile(in / "vector_x.pcd", vector_x.str());
+  expectRejected(in / "vector_x.pcd", "field x");
+
+  std::ostringstream no_z;
+  no_z << pcdHeader("x y", "4 4", "F F", "1 1", cloud.size(), "ascii");
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    no_z << "0 0\n";
+  writeFile(in / "no_z.pcd", no_z.str());
+  expectRejected(in / "no_z.pcd", "no x, y and z");
+}
+
+TEST_F(ToolFailure, UnwritableLocationsLeaveNothing)
+{
+  writeFile(dir / "out" / "a_file", "not a folder");
+  const std::string in = shellQuoted(scan) + " -ignore_viewpoint";
+  const std::vector<std::string> targets = {
+      (dir / "out" / "a_file" / "labels.pcd").string(), // under a file: ENOTDIR
+      (dir / "out" / "missing" / "labels.pcd").string(), // no such folder
+      "/proc/selseg_labels.pcd",                          // a read-only file system
+  };
+  for (const auto& target : targets) {
+    const Outcome o =
+        run(in + " -json " + shellQuoted(dir / "out" / "summary.json") + " -o '" + target + "'");
+    EXPECT_EQ(o.code, 1) << target << ": " << o.messages;
+    EXPECT_NE(o.messages.find("Cannot write"), std::string::npos) << o.messages;
+    EXPECT_EQ(outputs(), std::vector<std::string>{"a_file"}) << target;
+  }
+  // An output that is an existing folder: refused before anything is replaced.
+  fs::create_directories(dir / "out" / "folder.pcd");
+  writeFile(dir / "out" / "summary.json", "old");
+  const Outcome o = run(in + " -json " + shellQuoted(dir / "out" / "summary.json") + " -o " +
+                        shellQuoted(dir / "out" / "folder.pcd"));
+  EXPECT_EQ(o.code, 1) << o.messages;
+  EXPECT_EQ(readFile(dir / "out" / "summary.json"), "old");
+  EXPECT_TRUE(fs::is_directory(dir / "out" / "folder.pcd"));
+  EXPECT_EQ(outputs().size(), 3u);
+}
+
+// A full disk: the child may write at most N KiB per file (bash's ulimit -f, SIGXFSZ
+// ignored, so writes fail with EFBIG). Whatever output hits the limit, the run fails
+// with a message and leaves no file; an old output of the same name is kept as it was.
+TEST_F(ToolFailure, FullDiskLeavesNothing)
+{
+  writeFile(dir / "out" / "labels.pcd", "old labels");
+  // (Not 0 KiB: LLVM's OpenMP runtime, in clang builds, then cannot create its
+  // registration file in /dev/shm and aborts at start-up, before the tool runs.)
+  for (const long limit : {4L, 16L, 600L, 2000L}) {
+    const Outcome o = run(shellQuoted(scan) + " -ignore_viewpoint" + allOutputs(), limit);
+    EXPECT_EQ(o.code, 1) << limit << " KiB: " << o.messages;
+    EXPECT_NE(o.messages.find("free space"), std::string::npos) << o.messages;
+    EXPECT_EQ(outputs(), std::vector<std::string>{"labels.pcd"}) << limit << " KiB";
+    EXPECT_EQ(readFile(dir / "out" / "labels.pcd"), "old labels") << limit << " KiB";
+  }
+  // Without the limit the same command succeeds and replaces the old file.
+  const Outcome o = run(shellQuoted(scan) + " -ignore_viewpoint" + allOutputs());
+  ASSERT_EQ(o.code, 0) << o.messages;
+  EXPECT_EQ(outputs().size(), 5u);
+  EXPECT_NE(readFile(dir / "out" / "labels.pcd"), "old labels");
+}
+
+// Two outputs naming one file, or an output naming the input, would silently lose a
+// result or the scan: usage errors.
+TEST_F(ToolFailure, OutputsThatCollideAreUsageErrors)
+{
+  const fs::path labels = dir / "out" / "x.pcd";
+  Outcome o = run(shellQuoted(scan) + " -ignore_viewpoint -o " + shellQuoted(labels) + " -leaves " +
+                  shellQuoted(labels));
+  EXPECT_EQ(o.code, 2) << o.messages;
+  EXPECT_NE(o.messages.find("same file"), std::string::npos) << o.messages;
+  const fs::path copy = dir / "in" / "scan.pcd";
+  fs::copy_file(scan, copy);
+  o = run(shellQuoted(copy) + " -ignore_viewpoint -o " + shellQuoted(dir / "in" / "." / "scan.pcd"));
+  EXPECT_EQ(o.code, 2) << o.messages;
+  EXPECT_NE(o.messages.find("input"), std::string::npos) << o.messages;
+  EXPECT_EQ(readFile(copy), readFile(scan));
+  EXPECT_TRUE(outputs().empty());
+}
+
+// A lying header must not make the tool allocate what the header claims.
+TEST_F(ToolFailure, LyingHeadersUseBoundedMemory)
+{
+  writeFile(dir / "in" / "huge.pcd",
+            pcdHeader("x y z", "4 4 4", "F F F", "1 1 1", 4000000000u, "ascii") +
+                "0 0 1\n");
+  const Outcome o = run(shellQuoted(dir / "in" / "huge.pcd") + " -ignore_viewpoint");
+  EXPECT_EQ(o.code, 1) << o.messages;
+  rusage usage{};
+  getrusage(RUSAGE_CHILDREN, &usage);
+  EXPECT_LT(usage.ru_maxrss, 1L << 20) << "KiB"; // below 1 GiB
+}
+
+int
+main(int argc, char** argv)
+{
+  ::testing::InitGoogleTest(&argc, argv);
+  if (argc > 2) {
+    tool = argv[1];
+    scan = argv[2];
+  }
+  return RUN_ALL_TESTS();
+}
