@@ -310,8 +310,10 @@ runScene(const Options& opt, const std::string& name, std::string& table)
       for (std::size_t i = 0; i < truth_angles.size(); ++i) {
         const auto& a = truth_angles[i];
         if (a.first >= w.theta_min && a.first <= w.theta_max && a.second >= w.phi_min &&
-            a.second <= w.phi_max)
-          holds = truth_covered[i] = 1;
+            a.second <= w.phi_max) {
+          truth_covered[i] = 1;
+          holds = true;
+        }
       }
       estimated += w.estimated_points;
       on_edge += holds ? w.estimated_points : 0;
