@@ -343,6 +343,55 @@ TEST(RegionsOfInterest, EdgeOnTrianglesInsideASegmentAreEvidence)
   EXPECT_EQ(stats.transition_vertices, 0u);
 }
 
+// sparse_by_area: after a finer scan of a tenth of the view, the vertex median spacing
+// is the fine scan's and most coarse vertices look sparse; the median over the area
+// stays the coarse scan's, and the sparse evidence stays where it was.
+TEST(RegionsOfInterest, SparseByAreaIsNotShiftedByARefinedWindow)
+{
+  const auto cloud = coarseCube();
+  SelectiveSegmentation<pcl::PointXYZL> seg;
+  seg.setInputCloud(cloud);
+  std::vector<pcl::PointIndices> clusters;
+  ASSERT_TRUE(seg.extract(clusters));
+  RegionOfInterestParameters p;
+  p.use_invalid_edges = false;
+  p.leaf_sigma_threshold = 0.0;
+  p.small_segment_points = 0;
+  const auto sparse = [&](bool by_area) {
+    p.sparse_by_area = by_area;
+    std::vector<RegionOfInterest> regions;
+    RegionOfInterestStats stats;
+    EXPECT_TRUE(computeRegionsOfInterest(seg, p, regions, &stats));
+    return stats.sparse_vertices;
+  };
+  const std::size_t vertex_before = sparse(false), area_before = sparse(true);
+  EXPECT_GT(vertex_before, 0u);
+  EXPECT_LE(area_before, vertex_before); // the area median is the larger spacing
+
+  const auto setup = sim::makeCubeScene();
+  sim::SensorParameters sensor = setup.sensor;
+  sensor.range_noise = 0.0005;
+  sim::SensorSimulator simulator;
+  ASSERT_TRUE(simulator.setParameters(sensor));
+  sim::ScanWindow w; // a tenth of the view, at a quarter of the coarse step
+  w.theta_min = sensor.theta_min;
+  w.theta_max = sensor.theta_min + 0.3 * (sensor.theta_max - sensor.theta_min);
+  w.phi_min = sensor.phi_min;
+  w.phi_max = sensor.phi_min + 0.33 * (sensor.phi_max - sensor.phi_min);
+  w.step = 0.0108 / 4.0;
+  w.scan_id = 9;
+  pcl::PointCloud<pcl::PointXYZL> fine;
+  ASSERT_TRUE(simulator.simulateWindow(setup.scene, w, fine));
+  ASSERT_GT(fine.size(), cloud->size()); // the fine vertices are the majority
+  ASSERT_TRUE(seg.update(fine, clusters));
+  const std::size_t vertex_after = sparse(false), area_after = sparse(true);
+  // Measured: by vertex 67 -> 2,093, by area 8 -> 12 (the window's tenth of the area
+  // lowers the area median a little).
+  EXPECT_GT(vertex_after, 10 * vertex_before);
+  EXPECT_LE(area_after, 2 * area_before);
+  EXPECT_LT(20 * area_after, vertex_after);
+}
+
 // Windows of different reasons over the same place merge into one with both reasons;
 // tiles never grow beyond max_window_size.
 TEST(RegionsOfInterest, OverlappingWindowsMerge)

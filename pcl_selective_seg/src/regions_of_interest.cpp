@@ -120,6 +120,26 @@ median(std::vector<double> v)
   return *mid;
 }
 
+/** The spacing that half the view's area is sampled at or below: the median of the
+ * spacings, each weighted by the area its vertex stands for (spacing^2). */
+double
+areaMedian(std::vector<double> v)
+{
+  if (v.empty())
+    return 0.0;
+  std::sort(v.begin(), v.end());
+  double total = 0.0;
+  for (const double s : v)
+    total += s * s;
+  double sum = 0.0;
+  for (const double s : v) {
+    sum += s * s;
+    if (sum >= 0.5 * total)
+      return s;
+  }
+  return v.back();
+}
+
 /** Median angular length of the mesh edges at each vertex [rad] (0 when isolated). */
 std::vector<double>
 vertexSpacing(const SphericalTriangulation& tri,
@@ -308,7 +328,7 @@ findEvidence(const SegmentationResult& result,
     for (const double s : spacing)
       if (s > 0.0)
         positive.push_back(s);
-    const double typical = median(positive);
+    const double typical = p.sparse_by_area ? areaMedian(positive) : median(positive);
     // An invalid edge triangle among sparse samples says "too coarse" rather than
     // "an edge" (holes are spanned by such triangles): such vertices are sparse only.
     for (std::size_t v = 0; v < nv; ++v)

@@ -76,6 +76,11 @@ struct PCL_EXPORTS RegionOfInterestParameters {
   /** \brief Vertices whose angular spacing exceeds this many times the median vertex
    * spacing of the scan are sparse evidence; 0: off. Valid: 0 or >= 1. */
   double sparse_factor = 2.0;
+  /** \brief The scan's typical spacing for sparse_factor: false, the median over the
+   * vertices; true, the median over the view's area (each vertex weighted by its
+   * spacing squared), which a few finely rescanned windows do not shift: with the
+   * vertex median, a scan refined in places calls every coarse vertex sparse. */
+  bool sparse_by_area = false;
 
   /** \brief Evidence of one kind in mesh-connected groups of fewer vertices is
    * ignored (isolated noise). Valid: >= 1. */
