@@ -27,6 +27,7 @@
 #include <iomanip>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "roi_json.h"
@@ -53,6 +54,7 @@ struct Options {
   double step_scale = 1.0;
   double window_steps = 2.0;
   double progressive = 1.0;
+  double seed = -1.0; ///< < 0: the scenes' own seeds
   pcl::selective_seg::RegionOfInterestParameters regions;
   pcl::selective_seg::SelectiveSegmentationParameters segmentation;
 };
@@ -91,10 +93,13 @@ printHelp(const char* program)
       "  -window_steps X        evidence tiles of X coarse steps; 0 = "
       "-roi_max_window_deg (default 2)\n"
       "  -step_scale S          multiply every step by S (S > 1: a quicker, coarser "
-      "run; default 1)\n\n"
+      "run; default 1)\n"
+      "  -seed N                the sensor's random seed (rays, dropouts, noise) for "
+      "every scan; default: the scene's own\n\n"
       "The loop sets the regions' step (the fine step), point budget and yield; the "
-      "other\nregion options apply (the budget flags are ignored; -roi_margin_spacings "
-      "is 0.5 here):\n",
+      "other\nregion options apply (the budget flags are ignored). The loop's own "
+      "defaults differ from those\nlisted below: -roi_margin_spacings 0.5 "
+      "-roi_valid_edges 1 -roi_edge_on 1 -roi_side_deg 25 -roi_sparse_by_area 1:\n",
       program);
   selseg_apps::printRegionHelp();
   print_info("Segmentation (both strategies):\n");
@@ -106,16 +111,17 @@ parseOptions(int argc, char** argv, Options& opt)
 {
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    const bool known =
-        a == "-out" || a == "-scenes" || a == "-iterations" || a == "-coarse_factor" ||
-        a == "-budget_fraction" || a == "-range_noise" || a == "-min_voxel_factor" ||
-        a == "-step_scale" || a == "-window_steps" || a == "-progressive" ||
-        std::find(selseg_apps::segmentationFlags().begin(),
-                  selseg_apps::segmentationFlags().end(),
-                  a) != selseg_apps::segmentationFlags().end() ||
-        std::find(selseg_apps::regionFlags().begin(),
-                  selseg_apps::regionFlags().end(),
-                  a) != selseg_apps::regionFlags().end();
+    const bool known = a == "-out" || a == "-scenes" || a == "-iterations" ||
+                       a == "-coarse_factor" || a == "-budget_fraction" ||
+                       a == "-range_noise" || a == "-min_voxel_factor" ||
+                       a == "-step_scale" || a == "-window_steps" ||
+                       a == "-progressive" || a == "-seed" ||
+                       std::find(selseg_apps::segmentationFlags().begin(),
+                                 selseg_apps::segmentationFlags().end(),
+                                 a) != selseg_apps::segmentationFlags().end() ||
+                       std::find(selseg_apps::regionFlags().begin(),
+                                 selseg_apps::regionFlags().end(),
+                                 a) != selseg_apps::regionFlags().end();
     if (!known || i + 1 >= argc) {
       print_error("%s '%s' (see -h).\n",
                   known ? "Missing value of" : "Unknown argument",
@@ -152,6 +158,7 @@ parseOptions(int argc, char** argv, Options& opt)
       !parseNumber(argc, argv, "-step_scale", opt.step_scale) ||
       !parseNumber(argc, argv, "-window_steps", opt.window_steps) ||
       !parseNumber(argc, argv, "-progressive", opt.progressive) ||
+      !parseNumber(argc, argv, "-seed", opt.seed) ||
       !selseg_apps::parseRegionOptions(argc, argv, opt.regions) ||
       !selseg_apps::parseSegmentationOptions(argc, argv, opt.segmentation))
     return false;
@@ -165,10 +172,12 @@ parseOptions(int argc, char** argv, Options& opt)
       !(opt.range_noise >= 0.0 && opt.range_noise <= 1.0) ||
       !(opt.min_voxel_factor >= 0.0) || !(opt.step_scale > 0.0) ||
       !(opt.window_steps >= 0.0) ||
-      (opt.progressive != 0.0 && opt.progressive != 1.0)) {
+      (opt.progressive != 0.0 && opt.progressive != 1.0) ||
+      !(opt.seed < 0.0 ||
+        (opt.seed <= 4294967295.0 && opt.seed == std::floor(opt.seed)))) {
     print_error("Need 0 <= iterations <= 100, coarse_factor >= 1, 0 < budget_fraction "
                 "<= 1, 0 <= range_noise <= 1, min_voxel_factor >= 0, step_scale > 0, "
-                "window_steps >= 0, progressive 0 or 1.\n");
+                "window_steps >= 0, progressive 0 or 1, seed a whole number < 2^32.\n");
     return false;
   }
   return true;
@@ -237,6 +246,8 @@ runScene(const Options& opt, const std::string& name, std::string& table)
   sim::parsePaperScene(name, which);
   sim::SimulationSetup setup = sim::makePaperScene(which);
   setup.sensor.range_noise = opt.range_noise;
+  if (opt.seed >= 0.0)
+    setup.sensor.seed = static_cast<std::uint32_t>(opt.seed);
   const double fine = fineStep(name) * opt.step_scale;
   const std::string base = opt.out + "/" + name;
 
@@ -282,10 +293,37 @@ runScene(const Options& opt, const std::string& name, std::string& table)
   std::vector<sim::ScanScore> rounds;
   bool files_ok = true;
   double min_voxel = 0.0;
+  // Where the windows go: the reference boundary points (sensor angles) inside a
+  // scanned window, and the share of the windows' estimated points in windows that
+  // hold one.
+  std::vector<std::pair<double, double>> truth_angles;
+  for (const auto& p : reference.points)
+    truth_angles.emplace_back(std::atan2(p.x, p.z), std::atan2(p.y, p.z));
+  std::vector<char> truth_covered(truth_angles.size(), 0);
   const auto observer = [&](const sim::LoopRound& r) {
     min_voxel = r.result->min_voxel_size;
     const auto& regions = *r.regions;
     const auto& stats = r.region_stats;
+    std::size_t on_edge = 0, estimated = 0;
+    for (const auto& w : regions) {
+      bool holds = false;
+      for (std::size_t i = 0; i < truth_angles.size(); ++i) {
+        const auto& a = truth_angles[i];
+        if (a.first >= w.theta_min && a.first <= w.theta_max && a.second >= w.phi_min &&
+            a.second <= w.phi_max) {
+          truth_covered[i] = 1;
+          holds = true;
+        }
+      }
+      estimated += w.estimated_points;
+      on_edge += holds ? w.estimated_points : 0;
+    }
+    if (estimated > 0)
+      print_info("%s: round %d windows: %.0f%% of their estimated points in windows "
+                 "on a true edge\n",
+                 name.c_str(),
+                 r.iteration,
+                 100.0 * static_cast<double>(on_edge) / static_cast<double>(estimated));
     if (r.iteration == 0) {
       files_ok = files_ok && savePcd(base + "_coarse.pcd", *r.cloud) &&
                  selseg_apps::writeRegionsJson(
@@ -313,6 +351,31 @@ runScene(const Options& opt, const std::string& name, std::string& table)
   if (!sim::runSelectiveLoop(setup, loop, reference, rounds, observer)) {
     print_error("%s: the selective loop failed.\n", name.c_str());
     return false;
+  }
+  {
+    double inside[2] = {0, 0}, outside[2] = {0, 0};
+    std::size_t n_in = 0;
+    for (std::size_t i = 0; i < truth_angles.size(); ++i) {
+      const double d[2] = {uniform.back().reference_distances[i],
+                           rounds.back().reference_distances[i]};
+      for (int k = 0; k < 2; ++k)
+        (truth_covered[i] ? inside : outside)[k] += d[k];
+      n_in += truth_covered[i] != 0;
+    }
+    const std::size_t n_out = truth_angles.size() - n_in;
+    print_info(
+        "%s: %zu of %zu true edge points (%.0f%%) inside a scanned window; mean "
+        "distance there %.2f mm (finest uniform) / %.2f mm (selective), outside "
+        "%.2f / %.2f mm\n",
+        name.c_str(),
+        n_in,
+        truth_angles.size(),
+        100.0 * static_cast<double>(n_in) /
+            static_cast<double>(std::max<std::size_t>(truth_angles.size(), 1)),
+        1000.0 * inside[0] / static_cast<double>(std::max<std::size_t>(n_in, 1)),
+        1000.0 * inside[1] / static_cast<double>(std::max<std::size_t>(n_in, 1)),
+        1000.0 * outside[0] / static_cast<double>(std::max<std::size_t>(n_out, 1)),
+        1000.0 * outside[1] / static_cast<double>(std::max<std::size_t>(n_out, 1)));
   }
   pcl::selective_seg::RegionOfInterestStats all;
   all.selected = scanned.size();
@@ -375,9 +438,8 @@ main(int argc, char** argv)
     return argc < 2 ? kUsageError : 0;
   }
   Options opt;
-  // The loop's windows: half a spacing of margin (the default of one spacing is for a
-  // single finer look without follow-up rounds).
-  opt.regions.margin_spacings = 0.5;
+  // The loop's windows (sim::loopRegionParameters()); the flags change them.
+  opt.regions = sim::loopRegionParameters();
   if (!parseOptions(argc, argv, opt))
     return kUsageError;
   std::string table =

@@ -15,6 +15,35 @@ mkdir -p "$out" "$images"
 
 "$build/apps/pcl_selective_seg_selective_loop" -out "$out" | tee "$out/log.txt"
 
+# One run is one draw of the sensor's random streams (rays, dropouts, noise, texture):
+# the same on seven other seeds, summarized in OUT/seeds.md (final round against the
+# finest uniform scan, per scene and seed, and the mean ratio).
+seeds="1 2 3 4 5 6 7"
+for seed in $seeds; do
+  mkdir -p "$out/seed_$seed"
+  "$build/apps/pcl_selective_seg_selective_loop" -out "$out/seed_$seed" -seed "$seed" \
+    > "$out/seed_$seed/log.txt"
+done
+{
+  echo "| scene | seed | finest uniform: points, accuracy (mm) | selective: points, accuracy (mm) | ratio |"
+  echo "|---|---|---|---|---|"
+  for scene in cube chair door; do
+    for dir in "$out" $(for seed in $seeds; do echo "$out/seed_$seed"; done); do
+      seed=42
+      [ "$dir" = "$out" ] || seed=${dir##*seed_}
+      awk -F'|' -v scene="$scene" -v seed="$seed" '
+        $2 == " " scene " " && $3 ~ /uniform/ {dp = $4 + 0; da = $7 + 0}
+        $2 == " " scene " " && $3 ~ /selective/ {sp = $4 + 0; sa = $7 + 0; sf = $5; gsub(/ /, "", sf)}
+        END {printf "| %s | %s | %d, %.2f | %d (%s), %.2f | %.2f |\n", scene, seed, dp, da, sp, sf, sa, sa / da}
+      ' "$dir/table.md"
+    done
+  done
+  echo
+} > "$out/seeds.md"
+awk -F'|' 'NR > 2 && NF > 3 {gsub(/ /, "", $2); n[$2]++; r[$2] += $6} END {for (s in n) printf "mean ratio, %s: %.2f over %d seeds\n", s, r[s] / n[s], n[s]}' \
+  "$out/seeds.md" | sort >> "$out/seeds.md"
+cat "$out/seeds.md"
+
 # Boundary accuracy against points acquired, one panel per scene.
 gnuplot <<GNUPLOT
 set terminal pngcairo size 1500,480 font ",11"

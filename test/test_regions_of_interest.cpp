@@ -259,6 +259,139 @@ TEST(RegionsOfInterest, WindowOverABandOfInvalidEdgeTriangles)
   EXPECT_LE(r.priority, p.transition_weight);
 }
 
+// min_side_angle: a band of invalid edge triangles between two segments is evidence
+// only when the segments' normals differ by more than the angle or the band is seen
+// edge-on (a depth jump).
+TEST(RegionsOfInterest, EdgeTrianglesBetweenAgreeingSegmentsAreNoEvidence)
+{
+  // Rows -4..3; the band between rows -1 and 0; rows 0..3 are segment 2.
+  GridMesh g = makeGrid(10, 8, 0.01, 3, {4, 7});
+  RegionOfInterestParameters p;
+  p.sparse_factor = 0.0;
+  p.small_segment_points = 0;
+  p.max_window_size = 1.0;
+  p.min_side_angle = 25.0 * M_PI / 180.0;
+  const auto evidence = [&]() {
+    std::vector<RegionOfInterest> regions;
+    RegionOfInterestStats stats;
+    EXPECT_TRUE(computeRegionsOfInterest(
+        g.result, g.tri, Eigen::Affine3f::Identity(), p, regions, &stats));
+    return stats.transition_vertices;
+  };
+  const auto tilt = [](double degrees) {
+    const double a = degrees * M_PI / 180.0;
+    return Eigen::Vector3f(
+        0.0f, static_cast<float>(-std::sin(a)), static_cast<float>(-std::cos(a)));
+  };
+  // Normals 20 deg apart: the same surface split by noise.
+  g.result.segments[0].normal = tilt(0.0);
+  g.result.segments[1].normal = tilt(20.0);
+  EXPECT_EQ(evidence(), 0u);
+  // 30 deg apart: a crease.
+  g.result.segments[1].normal = tilt(30.0);
+  EXPECT_EQ(evidence(), 20u);
+  // Off: every edge triangle is evidence.
+  g.result.segments[1].normal = tilt(0.0);
+  p.min_side_angle = 0.0;
+  EXPECT_EQ(evidence(), 20u);
+  p.min_side_angle = 25.0 * M_PI / 180.0;
+  EXPECT_EQ(evidence(), 0u);
+  // A corner without a segment: evidence.
+  g.result.labels[g.tri.vertex_point[4]] = 0; // column 0, row 0
+  EXPECT_GT(evidence(), 0u);
+  g.result.labels[g.tri.vertex_point[4]] = 2;
+  // Parallel normals, but segment 2 lies 2 m behind: the band is seen edge-on.
+  for (std::size_t v = 0; v < g.tri.vertex_positions.size(); ++v)
+    if (g.result.labels[g.tri.vertex_point[v]] == 2)
+      g.tri.vertex_positions[v] *= 3.0f;
+  EXPECT_EQ(evidence(), 20u);
+  // ... unless edge-on means more than 89.9 deg (the band is at about 89.7 deg).
+  p.edge_on_angle = 89.9 * M_PI / 180.0;
+  EXPECT_EQ(evidence(), 0u);
+}
+
+// use_edge_on: a depth jump inside one segment (two surfaces at different depths
+// whose normals agree, merged) is transition evidence.
+TEST(RegionsOfInterest, EdgeOnTrianglesInsideASegmentAreEvidence)
+{
+  GridMesh g = makeGrid(10, 8, 0.01, -1); // one segment, interior triangles only
+  for (std::size_t v = 0; v < g.tri.vertex_positions.size(); ++v)
+    if (v % 8 >= 4) // rows 0..3 (phi >= 0) lie 2 m behind rows -4..-1
+      g.tri.vertex_positions[v] *= 3.0f;
+  RegionOfInterestParameters p;
+  p.sparse_factor = 0.0;
+  p.small_segment_points = 0;
+  p.max_window_size = 1.0;
+  std::vector<RegionOfInterest> regions;
+  RegionOfInterestStats stats;
+  ASSERT_TRUE(computeRegionsOfInterest(
+      g.result, g.tri, Eigen::Affine3f::Identity(), p, regions, &stats));
+  EXPECT_EQ(stats.transition_vertices, 0u);
+  EXPECT_TRUE(regions.empty());
+  p.use_edge_on = true;
+  ASSERT_TRUE(computeRegionsOfInterest(
+      g.result, g.tri, Eigen::Affine3f::Identity(), p, regions, &stats));
+  EXPECT_EQ(stats.transition_vertices, 20u); // rows -1 and 0, every column
+  ASSERT_EQ(regions.size(), 1u);
+  EXPECT_EQ(regions[0].reasons, kTransition);
+  EXPECT_NEAR(regions[0].phi_min, -0.01 - 0.01, 1e-6); // one spacing of margin
+  EXPECT_NEAR(regions[0].phi_max, 0.0 + 0.01, 1e-6);
+  // A flat grid has no edge-on triangle.
+  const GridMesh flat = makeGrid(10, 8, 0.01, -1);
+  ASSERT_TRUE(computeRegionsOfInterest(
+      flat.result, flat.tri, Eigen::Affine3f::Identity(), p, regions, &stats));
+  EXPECT_EQ(stats.transition_vertices, 0u);
+}
+
+// sparse_by_area: after a finer scan of a tenth of the view, the vertex median spacing
+// is the fine scan's and most coarse vertices look sparse; the median over the area
+// stays the coarse scan's, and the sparse evidence stays where it was.
+TEST(RegionsOfInterest, SparseByAreaIsNotShiftedByARefinedWindow)
+{
+  const auto cloud = coarseCube();
+  SelectiveSegmentation<pcl::PointXYZL> seg;
+  seg.setInputCloud(cloud);
+  std::vector<pcl::PointIndices> clusters;
+  ASSERT_TRUE(seg.extract(clusters));
+  RegionOfInterestParameters p;
+  p.use_invalid_edges = false;
+  p.leaf_sigma_threshold = 0.0;
+  p.small_segment_points = 0;
+  const auto sparse = [&](bool by_area) {
+    p.sparse_by_area = by_area;
+    std::vector<RegionOfInterest> regions;
+    RegionOfInterestStats stats;
+    EXPECT_TRUE(computeRegionsOfInterest(seg, p, regions, &stats));
+    return stats.sparse_vertices;
+  };
+  const std::size_t vertex_before = sparse(false), area_before = sparse(true);
+  EXPECT_GT(vertex_before, 0u);
+  EXPECT_LE(area_before, vertex_before); // the area median is the larger spacing
+
+  const auto setup = sim::makeCubeScene();
+  sim::SensorParameters sensor = setup.sensor;
+  sensor.range_noise = 0.0005;
+  sim::SensorSimulator simulator;
+  ASSERT_TRUE(simulator.setParameters(sensor));
+  sim::ScanWindow w; // a tenth of the view, at a quarter of the coarse step
+  w.theta_min = sensor.theta_min;
+  w.theta_max = sensor.theta_min + 0.3 * (sensor.theta_max - sensor.theta_min);
+  w.phi_min = sensor.phi_min;
+  w.phi_max = sensor.phi_min + 0.33 * (sensor.phi_max - sensor.phi_min);
+  w.step = 0.0108 / 4.0;
+  w.scan_id = 9;
+  pcl::PointCloud<pcl::PointXYZL> fine;
+  ASSERT_TRUE(simulator.simulateWindow(setup.scene, w, fine));
+  ASSERT_GT(fine.size(), cloud->size()); // the fine vertices are the majority
+  ASSERT_TRUE(seg.update(fine, clusters));
+  const std::size_t vertex_after = sparse(false), area_after = sparse(true);
+  // Measured: by vertex 67 -> 2,093, by area 8 -> 12 (the window's tenth of the area
+  // lowers the area median a little).
+  EXPECT_GT(vertex_after, 10 * vertex_before);
+  EXPECT_LE(area_after, 2 * area_before);
+  EXPECT_LT(20 * area_after, vertex_after);
+}
+
 // Windows of different reasons over the same place merge into one with both reasons;
 // tiles never grow beyond max_window_size.
 TEST(RegionsOfInterest, OverlappingWindowsMerge)

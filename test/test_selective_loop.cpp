@@ -119,7 +119,6 @@ TEST(SelectiveLoop, RefinementImprovesTheBoundaryAccuracy)
   params.fine_step = fine;
   params.iterations = 2;
   params.point_budget = dense.points * 3 / 10;
-  params.regions.margin_spacings = 0.5; // as pcl_selective_seg_selective_loop
   std::vector<sim::ScanScore> rounds;
   int calls = 0;
   ASSERT_TRUE(sim::runSelectiveLoop(
@@ -147,4 +146,33 @@ TEST(SelectiveLoop, BadParametersAreRejected)
   params = sim::SelectiveLoopParameters();
   params.point_budget = 0;
   EXPECT_FALSE(sim::runSelectiveLoop(cube(), params, reference, rounds));
+}
+
+// A draw of the cube's sensor (seed 6) whose coarse segmentation merges the cube's top
+// face with the floor behind it (parallel normals, one coarse octree leaf): no edge
+// triangle marks that occluding edge. Edge-on triangles (the depth jump) do, and the
+// loop refines it; without them the edge stays at the coarse scan's error.
+TEST(SelectiveLoop, DepthJumpsInsideASegmentAreRefined)
+{
+  auto setup = cube();
+  setup.sensor.seed = 6;
+  const double fine = 0.0036;
+  sim::ReferenceBoundary reference;
+  ASSERT_TRUE(sim::makeReferenceBoundary(setup, 0.5 * fine, reference));
+  sim::SelectiveLoopParameters params;
+  params.fine_step = fine;
+  params.point_budget = 6700; // 30% of the uniform scan at the fine step
+  std::vector<sim::ScanScore> with, without;
+  ASSERT_TRUE(sim::runSelectiveLoop(setup, params, reference, with));
+  params.regions.use_edge_on = false;
+  params.regions.use_valid_edges = false;
+  params.regions.min_side_angle = 0.0;
+  ASSERT_TRUE(sim::runSelectiveLoop(setup, params, reference, without));
+  ASSERT_EQ(with.size(), 4u);
+  ASSERT_EQ(without.size(), 4u);
+  // The coarse scans are the same; the refined results are not.
+  EXPECT_EQ(with[0].accuracy.mean, without[0].accuracy.mean);
+  EXPECT_GT(with[0].accuracy.mean, 0.025);
+  EXPECT_LT(with.back().accuracy.mean, 0.5 * without.back().accuracy.mean);
+  EXPECT_LT(with.back().accuracy.p90, 0.5 * without.back().accuracy.p90);
 }

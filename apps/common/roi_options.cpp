@@ -22,22 +22,14 @@ constexpr double kDeg = M_PI / 180.0;
 const std::vector<std::string>&
 regionFlags()
 {
-  static const std::vector<std::string> flags = {"-roi_max_sr",
-                                                 "-roi_max_points",
-                                                 "-roi_max_regions",
-                                                 "-roi_yield",
-                                                 "-roi_step_deg",
-                                                 "-roi_refine",
-                                                 "-roi_max_window_deg",
-                                                 "-roi_min_window_deg",
-                                                 "-roi_margin_deg",
-                                                 "-roi_margin_spacings",
-                                                 "-roi_small_points",
-                                                 "-roi_min_component",
-                                                 "-roi_valid_edges",
-                                                 "-roi_sparse_factor",
-                                                 "-roi_leaf_sigma_deg",
-                                                 "-roi_weights"};
+  static const std::vector<std::string> flags = {
+      "-roi_max_sr",          "-roi_max_points",     "-roi_max_regions",
+      "-roi_yield",           "-roi_step_deg",       "-roi_refine",
+      "-roi_max_window_deg",  "-roi_min_window_deg", "-roi_margin_deg",
+      "-roi_margin_spacings", "-roi_small_points",   "-roi_min_component",
+      "-roi_valid_edges",     "-roi_sparse_factor",  "-roi_leaf_sigma_deg",
+      "-roi_side_deg",        "-roi_edge_on_deg",    "-roi_edge_on",
+      "-roi_sparse_by_area",  "-roi_weights"};
   return flags;
 }
 
@@ -70,8 +62,19 @@ printRegionHelp()
       "is ignored (default %zu)\n"
       "  -roi_sparse_factor X     spacing above X times the median is evidence; 0 = "
       "off (default %g)\n"
+      "  -roi_sparse_by_area 0|1  the typical spacing is the median over the view's "
+      "area, not over the vertices\n"
+      "                           (default %d)\n"
       "  -roi_leaf_sigma_deg X    finest leaves with a larger normal spread are "
       "evidence; 0 = off (default %g)\n"
+      "  -roi_side_deg X          edge triangles are evidence only when seen "
+      "edge-on or between segments\n"
+      "                           whose normals differ by more than X; 0 = off "
+      "(default %g)\n"
+      "  -roi_edge_on 0|1         triangles seen edge-on (depth jumps) are "
+      "transition evidence (default %d)\n"
+      "  -roi_edge_on_deg X       edge-on: more than X between the triangle normal "
+      "and the line of sight (default %g)\n"
       "  -roi_weights I,L,V,S,P   priority weights of transition evidence from "
       "invalid edges, leaves, valid\n"
       "                           edges, and of small-segment and sparse evidence "
@@ -90,7 +93,11 @@ printRegionHelp()
       d.use_valid_edges ? 1 : 0,
       d.min_component_vertices,
       d.sparse_factor,
+      d.sparse_by_area ? 1 : 0,
       d.leaf_sigma_threshold / kDeg,
+      d.min_side_angle / kDeg,
+      d.use_edge_on ? 1 : 0,
+      d.edge_on_angle / kDeg,
       d.transition_weight,
       d.leaf_weight,
       d.valid_edge_weight,
@@ -105,12 +112,15 @@ parseRegionOptions(int argc,
 {
   double step = p.target_step / kDeg, max_window = p.max_window_size / kDeg,
          min_window = p.min_window_size / kDeg, margin = p.margin / kDeg,
-         sigma = p.leaf_sigma_threshold / kDeg;
+         sigma = p.leaf_sigma_threshold / kDeg, side = p.min_side_angle / kDeg,
+         edge_on = p.edge_on_angle / kDeg;
   double max_points = static_cast<double>(p.max_points),
          max_regions = static_cast<double>(p.max_regions),
          small = static_cast<double>(p.small_segment_points),
          component = static_cast<double>(p.min_component_vertices),
-         valid_edges = p.use_valid_edges ? 1.0 : 0.0;
+         valid_edges = p.use_valid_edges ? 1.0 : 0.0,
+         edge_on_triangles = p.use_edge_on ? 1.0 : 0.0,
+         by_area = p.sparse_by_area ? 1.0 : 0.0;
   if (!parseNumber(argc, argv, "-roi_max_sr", p.max_solid_angle) ||
       !parseNumber(argc, argv, "-roi_max_points", max_points) ||
       !parseNumber(argc, argv, "-roi_max_regions", max_regions) ||
@@ -125,7 +135,11 @@ parseRegionOptions(int argc,
       !parseNumber(argc, argv, "-roi_min_component", component) ||
       !parseNumber(argc, argv, "-roi_valid_edges", valid_edges) ||
       !parseNumber(argc, argv, "-roi_sparse_factor", p.sparse_factor) ||
-      !parseNumber(argc, argv, "-roi_leaf_sigma_deg", sigma))
+      !parseNumber(argc, argv, "-roi_leaf_sigma_deg", sigma) ||
+      !parseNumber(argc, argv, "-roi_side_deg", side) ||
+      !parseNumber(argc, argv, "-roi_edge_on_deg", edge_on) ||
+      !parseNumber(argc, argv, "-roi_edge_on", edge_on_triangles) ||
+      !parseNumber(argc, argv, "-roi_sparse_by_area", by_area))
     return false;
   for (const auto& [flag, value] : {std::make_pair("-roi_max_points", max_points),
                                     std::make_pair("-roi_max_regions", max_regions),
@@ -158,11 +172,23 @@ parseRegionOptions(int argc,
     return false;
   }
   p.use_valid_edges = valid_edges == 1.0;
+  if (edge_on_triangles != 0.0 && edge_on_triangles != 1.0) {
+    pcl::console::print_error("Option -roi_edge_on needs 0 or 1.\n");
+    return false;
+  }
+  p.use_edge_on = edge_on_triangles == 1.0;
+  if (by_area != 0.0 && by_area != 1.0) {
+    pcl::console::print_error("Option -roi_sparse_by_area needs 0 or 1.\n");
+    return false;
+  }
+  p.sparse_by_area = by_area == 1.0;
   p.target_step = step * kDeg;
   p.max_window_size = max_window * kDeg;
   p.min_window_size = min_window * kDeg;
   p.margin = margin * kDeg;
   p.leaf_sigma_threshold = sigma * kDeg;
+  p.min_side_angle = side * kDeg;
+  p.edge_on_angle = edge_on * kDeg;
   std::string why;
   if (!p.validate(&why)) {
     pcl::console::print_error("Region of interest %s.\n", why.c_str());

@@ -120,6 +120,26 @@ median(std::vector<double> v)
   return *mid;
 }
 
+/** The spacing that half the view's area is sampled at or below: the median of the
+ * spacings, each weighted by the area its vertex stands for (spacing^2). */
+double
+areaMedian(std::vector<double> v)
+{
+  if (v.empty())
+    return 0.0;
+  std::sort(v.begin(), v.end());
+  double total = 0.0;
+  for (const double s : v)
+    total += s * s;
+  double sum = 0.0;
+  for (const double s : v) {
+    sum += s * s;
+    if (sum >= 0.5 * total)
+      return s;
+  }
+  return v.back();
+}
+
 /** Median angular length of the mesh edges at each vertex [rad] (0 when isolated). */
 std::vector<double>
 vertexSpacing(const SphericalTriangulation& tri,
@@ -208,6 +228,58 @@ markLeafEvidence(const SegmentationResult& result,
       kinds[v] |= kTransition;
 }
 
+/** Whether triangle \a t is seen edge-on: more than edge_on_angle between its normal
+ * and the line of sight to its centroid (the sensor is at the origin of the sensor
+ * frame); a degenerate triangle counts as edge-on when \a degenerate is true. */
+bool
+edgeOn(const SphericalTriangulation& tri,
+       std::size_t t,
+       const RegionOfInterestParameters& p,
+       bool degenerate = true)
+{
+  const auto& corners = tri.triangles[t];
+  const Eigen::Vector3d a = tri.vertex_positions[corners[0]].cast<double>();
+  const Eigen::Vector3d b = tri.vertex_positions[corners[1]].cast<double>();
+  const Eigen::Vector3d c = tri.vertex_positions[corners[2]].cast<double>();
+  const Eigen::Vector3d normal = (b - a).cross(c - a);
+  const Eigen::Vector3d ray = a + b + c;
+  const double n = normal.norm() * ray.norm();
+  if (!(n > 0.0) || !std::isfinite(n))
+    return degenerate;
+  return std::abs(normal.dot(ray)) < std::cos(p.edge_on_angle) * n;
+}
+
+/** Whether edge triangle \a t separates two surfaces (min_side_angle): seen edge-on,
+ * a corner without a segment, or segments whose normals differ by more than
+ * min_side_angle. */
+bool
+twoSurfaces(const SegmentationResult& result,
+            const SphericalTriangulation& tri,
+            std::size_t t,
+            const RegionOfInterestParameters& p)
+{
+  if (!(p.min_side_angle > 0.0) || edgeOn(tri, t, p))
+    return true;
+  const auto& corners = tri.triangles[t];
+  const double cos_side = std::cos(p.min_side_angle);
+  std::uint32_t labels[3];
+  for (int k = 0; k < 3; ++k) {
+    labels[k] = result.labels[tri.vertex_point[corners[k]]];
+    if (labels[k] == 0 || labels[k] > result.segments.size())
+      return true;
+  }
+  for (int i = 0; i < 3; ++i)
+    for (int j = i + 1; j < 3; ++j) {
+      if (labels[i] == labels[j])
+        continue;
+      const Eigen::Vector3f& ni = result.segments[labels[i] - 1].normal;
+      const Eigen::Vector3f& nj = result.segments[labels[j] - 1].normal;
+      if (static_cast<double>(ni.dot(nj)) < cos_side)
+        return true;
+    }
+  return false;
+}
+
 /** Evidence bits of every vertex. */
 std::vector<std::uint8_t>
 findEvidence(const SegmentationResult& result,
@@ -228,7 +300,11 @@ findEvidence(const SegmentationResult& result,
   };
   for (std::size_t t = 0; t < tri.triangles.size(); ++t) {
     const auto c = result.mesh.classes[t];
-    if (p.use_invalid_edges && c == TriangleClass::InvalidEdge)
+    if ((c == TriangleClass::InvalidEdge || c == TriangleClass::ValidEdge) &&
+        !twoSurfaces(result, tri, t, p))
+      continue;
+    if ((p.use_invalid_edges && c == TriangleClass::InvalidEdge) ||
+        (p.use_edge_on && edgeOn(tri, t, p, false)))
       for (const auto v : tri.triangles[t])
         mark(static_cast<std::size_t>(v), p.transition_weight);
     else if (p.use_valid_edges && c == TriangleClass::ValidEdge)
@@ -252,7 +328,7 @@ findEvidence(const SegmentationResult& result,
     for (const double s : spacing)
       if (s > 0.0)
         positive.push_back(s);
-    const double typical = median(positive);
+    const double typical = p.sparse_by_area ? areaMedian(positive) : median(positive);
     // An invalid edge triangle among sparse samples says "too coarse" rather than
     // "an edge" (holes are spanned by such triangles): such vertices are sparse only.
     for (std::size_t v = 0; v < nv; ++v)
@@ -460,6 +536,10 @@ RegionOfInterestParameters::validate(std::string* why) const
 {
   if (!std::isfinite(leaf_sigma_threshold))
     return reject(why, "leaf_sigma_threshold", leaf_sigma_threshold, "finite [rad]");
+  if (!(min_side_angle >= 0.0 && min_side_angle <= M_PI))
+    return reject(why, "min_side_angle", min_side_angle, "[0, pi] [rad]");
+  if (!(edge_on_angle > 0.0 && edge_on_angle <= kHalfPi))
+    return reject(why, "edge_on_angle", edge_on_angle, "(0, pi/2] [rad]");
   if (!(sparse_factor == 0.0 || finiteAtLeast(sparse_factor, 1.0)))
     return reject(why, "sparse_factor", sparse_factor, "0 or [1, inf)");
   if (min_component_vertices < 1)

@@ -67,6 +67,19 @@ fail(const char* what)
 
 } // namespace
 
+RegionOfInterestParameters
+loopRegionParameters()
+{
+  RegionOfInterestParameters p;
+  p.margin_spacings = 0.5;
+  p.use_valid_edges = true;
+  p.use_edge_on = true;
+  p.edge_on_angle = 85.0 * M_PI / 180.0;
+  p.min_side_angle = 25.0 * M_PI / 180.0;
+  p.sparse_by_area = true;
+  return p;
+}
+
 bool
 makeReferenceBoundary(const SimulationSetup& setup,
                       double step,

@@ -46,6 +46,25 @@ struct PCL_EXPORTS RegionOfInterestParameters {
   /** \brief Valid edge triangles (segment borders the surface continues across) are
    * transition evidence too (with use_invalid_edges). */
   bool use_valid_edges = false;
+  /** \brief Triangles seen edge-on (more than edge_on_angle between their normal and
+   * the line of sight: a depth discontinuity) are transition evidence whatever their
+   * class, with transition_weight: two surfaces at different depths whose normals
+   * agree can share a coarse octree leaf and so one segment (a box's top face before
+   * the floor behind it), and then give no edge triangle. */
+  bool use_edge_on = false;
+  /** \brief Edge triangles (invalid, and valid with use_valid_edges) are evidence only
+   * where the segmentation sees two different surfaces: the triangle is seen edge-on
+   * (more than edge_on_angle between its normal and the line of sight: a depth
+   * discontinuity), or the normals of the segments of its corners differ by more than
+   * this angle [rad] (a crease by the merge criterion: the segmentation's
+   * max_merge_angle, 25 deg by default, is the natural value), or a corner has no
+   * segment. Edge triangles between segments whose normals agree are splits by range
+   * noise, not transitions. 0: every edge triangle is evidence. Valid: [0, pi]. */
+  double min_side_angle = 0.0;
+  /** \brief See use_edge_on and min_side_angle [rad]; the segmentation's
+   * max_view_incidence_angle (85 deg by default) is the natural value. Valid: (0,
+   * pi/2]. */
+  double edge_on_angle = 85.0 * M_PI / 180.0;
   /** \brief Finest-size octree leaves (the smallest leaf size of the result) whose
    * sigma_theta or sigma_phi exceeds this are transition evidence [rad]; the
    * segmentation's split threshold (max_normal_std_dev, 7.6 deg by default) is the
@@ -57,6 +76,11 @@ struct PCL_EXPORTS RegionOfInterestParameters {
   /** \brief Vertices whose angular spacing exceeds this many times the median vertex
    * spacing of the scan are sparse evidence; 0: off. Valid: 0 or >= 1. */
   double sparse_factor = 2.0;
+  /** \brief The scan's typical spacing for sparse_factor: false, the median over the
+   * vertices; true, the median over the view's area (each vertex weighted by its
+   * spacing squared), which a few finely rescanned windows do not shift: with the
+   * vertex median, a scan refined in places calls every coarse vertex sparse. */
+  bool sparse_by_area = false;
 
   /** \brief Evidence of one kind in mesh-connected groups of fewer vertices is
    * ignored (isolated noise). Valid: >= 1. */

@@ -68,6 +68,16 @@ PCL_EXPORTS bool scoreSegmentation(const pcl::PointCloud<pcl::PointXYZL>& cloud,
                                    double max_edge_angle,
                                    ScanScore& score);
 
+/** \brief The loop's regions of interest: the library defaults, with half a spacing
+ * of margin (the default of one spacing is for a single finer look without follow-up
+ * rounds), and as transition evidence every edge triangle, valid or invalid, between
+ * two surfaces: seen edge-on (a depth jump, 85 deg: the segmentation's
+ * max_view_incidence_angle), or between segments whose normals differ by more than the
+ * segmentation's merge angle (25 deg), whatever the triangle's class; sparse areas
+ * relative to the median spacing over the view's area, which the refined windows do
+ * not shift (docs/selective_sensing.md measures each choice). */
+PCL_EXPORTS RegionOfInterestParameters loopRegionParameters();
+
 /** \brief Parameters of the simulated coarse-to-fine loop. */
 struct PCL_EXPORTS SelectiveLoopParameters {
   /** \brief Angular step of the finest scans: the target step of the last round's
@@ -98,7 +108,7 @@ struct PCL_EXPORTS SelectiveLoopParameters {
   /** \brief The regions of interest; target_step, max_points and sample_yield are set
    * by the loop (the yield from the coarse scan, then corrected each round by the
    * points a round's windows actually returned over their estimate). */
-  RegionOfInterestParameters regions;
+  RegionOfInterestParameters regions = loopRegionParameters();
 };
 
 /** \brief One round of the loop, as reported to the observer. */
