@@ -654,7 +654,8 @@ delaunay2d(const std::vector<QuantizedPoint>& points,
 void
 computeTriangleNeighbours(const std::vector<Triangle>& triangles,
                           std::size_t num_vertices,
-                          std::vector<Triangle>& neighbours)
+                          std::vector<Triangle>& neighbours,
+                          unsigned int num_threads)
 {
   // Bucket the half-edges by their origin vertex (compressed rows), each stored as
   // (end vertex, triangle). The half-edge opposite corner i of triangle t runs from
@@ -671,8 +672,13 @@ computeTriangleNeighbours(const std::vector<Triangle>& triangles,
     for (std::size_t i = 0; i < 3; ++i)
       half_edges[cursor[triangles[t][i]]++] = {triangles[t][(i + 1) % 3],
                                                static_cast<index_t>(t)};
-  neighbours.assign(triangles.size(), Triangle{-1, -1, -1});
-  for (std::size_t t = 0; t < triangles.size(); ++t) {
+  neighbours.resize(triangles.size());
+  // Each triangle's entries are its own: the same result for any thread count.
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(std::max(1u, num_threads)) schedule(static)
+#endif
+  for (std::ptrdiff_t t = 0; t < static_cast<std::ptrdiff_t>(triangles.size()); ++t) {
+    neighbours[t] = Triangle{-1, -1, -1};
     for (std::size_t i = 0; i < 3; ++i) {
       const index_t origin = triangles[t][(i + 1) % 3];
       const index_t end = triangles[t][(i + 2) % 3];

@@ -50,7 +50,8 @@ struct SphericalTriangulation {
   std::vector<Eigen::Vector3f> vertex_positions;
   /** #T triangles over vertex ids, counter-clockwise in (theta, phi). */
   std::vector<Triangle> triangles;
-  /** #T triangle across the edge opposite each vertex, -1 on the boundary. */
+  /** #T triangle across the edge opposite each vertex, -1 on the boundary (empty when
+   * SphericalDelaunay::setComputeNeighbours(false)). */
   std::vector<Triangle> neighbours;
   std::size_t num_outside_indices = 0;
   std::size_t num_non_finite = 0;
@@ -86,6 +87,11 @@ public:
   /** \brief Triangulation backend (default: DelaunayBackend::Sweep). */
   void setBackend(DelaunayBackend backend) { backend_ = backend; }
   DelaunayBackend getBackend() const { return backend_; }
+
+  /** \brief Whether triangulate() also fills SphericalTriangulation::neighbours
+   * (default true). */
+  void setComputeNeighbours(bool compute) { compute_neighbours_ = compute; }
+  bool getComputeNeighbours() const { return compute_neighbours_; }
 
   /** \brief Grid step of the angle quantization [rad], in [2.5e-8, 1e-2]. */
   void setAngleQuantization(double step) { angle_quantization_ = step; }
@@ -159,6 +165,7 @@ private:
   bool has_sensor_pose_ = false;
   SphericalTriangulation triangulation_;
   unsigned int num_threads_ = defaultThreads();
+  bool compute_neighbours_ = true;
 };
 
 } // namespace selective_seg

@@ -6,6 +6,7 @@
 
 #pragma once
 
+#include <pcl_selective_seg/impl/radix_sort.hpp>
 #include <pcl_selective_seg/spherical_delaunay.h>
 
 #include <pcl/common/point_tests.h>
@@ -40,6 +41,43 @@ keyAngles(std::uint64_t key)
 
 /** \brief Key of an excluded point (sorts last); its index then holds the status. */
 constexpr std::uint64_t kExcludedKey = ~std::uint64_t(0);
+
+/** \brief Sorts (angle key, point) pairs by key: a radix sort of the keys packed
+ * relative to the smallest theta and phi (entries with equal keys may come in any
+ * order; the callers do not depend on it). */
+inline void
+sortByAngleKey(std::vector<std::pair<std::uint64_t, pcl::index_t>>& entries)
+{
+  if (entries.size() < 2)
+    return;
+  std::uint32_t lo_theta = ~0u, hi_theta = 0, lo_phi = ~0u, hi_phi = 0;
+  for (const auto& e : entries) {
+    const auto theta = static_cast<std::uint32_t>(e.first >> 32);
+    const auto phi = static_cast<std::uint32_t>(e.first);
+    lo_theta = std::min(lo_theta, theta);
+    hi_theta = std::max(hi_theta, theta);
+    lo_phi = std::min(lo_phi, phi);
+    hi_phi = std::max(hi_phi, phi);
+  }
+  const int phi_bits = bitWidth(hi_phi - lo_phi);
+  const int bits = phi_bits + bitWidth(hi_theta - lo_theta);
+  const auto pack = [&](std::uint64_t key) {
+    return (std::uint64_t{static_cast<std::uint32_t>(key >> 32) - lo_theta}
+            << phi_bits) |
+           (static_cast<std::uint32_t>(key) - lo_phi);
+  };
+  const std::uint64_t phi_mask = (std::uint64_t{1} << phi_bits) - 1;
+  const auto unpack = [&](std::uint64_t packed) {
+    return (std::uint64_t{static_cast<std::uint32_t>(packed >> phi_bits) + lo_theta}
+            << 32) |
+           (static_cast<std::uint32_t>(packed & phi_mask) + lo_phi);
+  };
+  for (auto& e : entries)
+    e.first = pack(e.first);
+  radixSortByKey(entries, bits);
+  for (auto& e : entries)
+    e.first = unpack(e.first);
+}
 
 } // namespace detail
 
@@ -104,7 +142,7 @@ SphericalDelaunay<PointT>::projectAndMergeVertices(SphericalTriangulation& resul
                                return e.first == detail::kExcludedKey;
                              }),
               keyed.end());
-  std::sort(keyed.begin(), keyed.end());
+  detail::sortByAngleKey(keyed);
   mergeEqualAngles(keyed, pose, result);
   for (const auto v : result.point_vertex) {
     result.num_outside_indices += (v == kOutsideIndices);
@@ -168,9 +206,11 @@ SphericalDelaunay<PointT>::triangulateVertices()
               why.c_str());
     return false;
   }
-  computeTriangleNeighbours(triangulation_.triangles,
-                            triangulation_.vertex_angles.size(),
-                            triangulation_.neighbours);
+  if (compute_neighbours_)
+    computeTriangleNeighbours(triangulation_.triangles,
+                              triangulation_.vertex_angles.size(),
+                              triangulation_.neighbours,
+                              num_threads_);
   return true;
 }
 
