@@ -67,6 +67,7 @@ PCL_EXPORTS void mergeSeedSegments(const MergeInput& input,
  * \param[in] max_edge_triangle_angle [rad]
  * \param[out] labels #T labels (0 when no vertex is labeled)
  * \param[out] classes #T classes
+ * \param[in] num_threads threads (0: all cores); the result does not depend on it
  */
 PCL_EXPORTS void classifyTriangles(const std::vector<Triangle>& triangles,
                                    const Vector3fVector& triangle_normals,
@@ -75,7 +76,8 @@ PCL_EXPORTS void classifyTriangles(const std::vector<Triangle>& triangles,
                                    const Vector3fVector& label_normals,
                                    double max_edge_triangle_angle,
                                    std::vector<std::uint32_t>& labels,
-                                   std::vector<TriangleClass>& classes);
+                                   std::vector<TriangleClass>& classes,
+                                   int num_threads = 1);
 
 /** \brief Compressed incidence lists: the items of group g are
  * items[offsets[g] .. offsets[g + 1]), in increasing item order.

@@ -67,6 +67,7 @@ SelectiveSegmentation<PointT>::triangulate()
   delaunay_.setBackend(params_.delaunay_backend);
   delaunay_.setAngleQuantization(params_.angle_quantization);
   delaunay_.setNumberOfThreads(static_cast<unsigned int>(params_.num_threads));
+  delaunay_.setComputeNeighbours(false); // computed once, into the result below
   if (!delaunay_.triangulate())
     return fail("extract", "the spherical triangulation failed (reason above)");
   const SphericalTriangulation& tri = delaunay_.getTriangulation();
@@ -87,6 +88,10 @@ SelectiveSegmentation<PointT>::triangulate()
                 "the " + std::to_string(tri.vertex_point.size()) +
                     " distinct viewing directions are fewer than three or all on one "
                     "line in (theta, phi): there is no surface to triangulate");
+  computeTriangleNeighbours(tri.triangles,
+                            tri.vertex_point.size(),
+                            result_.mesh.neighbours,
+                            static_cast<unsigned int>(numThreads()));
   return true;
 }
 
@@ -125,21 +130,11 @@ SelectiveSegmentation<PointT>::computeNormals()
                                   triangle_areas_,
                                   params_.normal_rings,
                                   vertex_normals_);
-  const float nan = std::numeric_limits<float>::quiet_NaN();
-  normals_.reset(
-      new NormalCloud(input_->width, input_->height, pcl::Normal(nan, nan, nan, nan)));
-  normals_->header = input_->header;
-  normals_->is_dense = false;
-  const Eigen::Matrix3f to_cloud = sensorToCloud();
-  bool any = false;
-  for (std::size_t i = 0; i < input_->size(); ++i) {
-    const pcl::index_t v = tri.point_vertex[i];
-    if (v < 0 || !vertex_normals_[v].allFinite())
-      continue;
-    (*normals_)[i].getNormalVector3fMap() = to_cloud * vertex_normals_[v];
-    (*normals_)[i].curvature = 0.0f;
-    any = true;
-  }
+  // Every vertex represents at least one point: a point has a normal if a vertex has.
+  const bool any =
+      std::any_of(vertex_normals_.begin(),
+                  vertex_normals_.end(),
+                  [](const Eigen::Vector3f& n) { return n.allFinite(); });
   result_.median_spacing = medianEdgeLength(positions, tri.triangles);
   if (!any)
     return fail("extract",
@@ -224,11 +219,15 @@ SelectiveSegmentation<PointT>::rankSegments(
     result_.segments[r].num_points = sizes[order[r]];
     result_.segments[r].normal = sensorToCloud() * segment_normals[order[r]];
   }
-  result_.labels.assign(input_->size(), 0);
-  for (std::size_t i = 0; i < input_->size(); ++i) {
+  result_.labels.resize(input_->size());
+  const auto num_points = static_cast<std::ptrdiff_t>(input_->size());
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(numThreads()) schedule(static)
+#endif
+  for (std::ptrdiff_t i = 0; i < num_points; ++i) {
     const pcl::index_t v = tri.point_vertex[i];
-    if (v >= 0 && vertex_segment[v] >= 0)
-      result_.labels[i] = segment_label[vertex_segment[v]];
+    result_.labels[i] =
+        v >= 0 && vertex_segment[v] >= 0 ? segment_label[vertex_segment[v]] : 0;
   }
 }
 
@@ -241,16 +240,15 @@ SelectiveSegmentation<PointT>::fillMeshAndLeaves(
 {
   const SphericalTriangulation& tri = delaunay_.getTriangulation();
   SegmentedMesh& mesh = result_.mesh;
+  const auto num_triangles = static_cast<std::ptrdiff_t>(tri.triangles.size());
   mesh.triangles.resize(tri.triangles.size());
-  for (std::size_t t = 0; t < tri.triangles.size(); ++t)
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(numThreads()) schedule(static)
+#endif
+  for (std::ptrdiff_t t = 0; t < num_triangles; ++t)
     for (int i = 0; i < 3; ++i)
       mesh.triangles[t][i] = tri.vertex_point[tri.triangles[t][i]];
-  mesh.neighbours = tri.neighbours;
   const Eigen::Matrix3f to_cloud = sensorToCloud();
-  mesh.normals.resize(triangle_normals_.size());
-  for (std::size_t t = 0; t < triangle_normals_.size(); ++t)
-    mesh.normals[t] = to_cloud * triangle_normals_[t];
-  mesh.areas = triangle_areas_;
   Vector3fVector label_normals; // sensor frame, like the triangle normals
   for (const auto& s : result_.segments)
     label_normals.push_back(to_cloud.transpose() * s.normal);
@@ -261,7 +259,19 @@ SelectiveSegmentation<PointT>::fillMeshAndLeaves(
                     label_normals,
                     params_.max_edge_triangle_angle,
                     mesh.labels,
-                    mesh.classes);
+                    mesh.classes,
+                    params_.num_threads);
+  // The triangle normals and areas move into the result (the normals turned to the
+  // cloud frame): the run needs them no more, and they are the largest arrays.
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(numThreads()) schedule(static)
+#endif
+  for (std::ptrdiff_t t = 0; t < num_triangles; ++t)
+    triangle_normals_[t] = to_cloud * triangle_normals_[t];
+  mesh.normals = std::move(triangle_normals_);
+  mesh.areas = std::move(triangle_areas_);
+  triangle_normals_.clear();
+  triangle_areas_.clear();
 
   const auto& leaves = octree_->getAdaptiveLeaves();
   result_.leaves.resize(leaves.size());
@@ -330,18 +340,26 @@ SelectiveSegmentation<PointT>::mergeAndLabel()
       vertex_labels[v] = segment_label[vertex_segment[v]];
   fillMeshAndLeaves(vertex_labels, leaf_segment, segment_label);
 
-  PointCounts& counts = result_.counts;
-  for (std::size_t i = 0; i < input_->size(); ++i) {
+  std::size_t without_normal = 0, labeled = 0, shared_vertex = 0;
+  const auto num_points = static_cast<std::ptrdiff_t>(input_->size());
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(numThreads()) schedule(static)           \
+    reduction(+ : without_normal, labeled, shared_vertex)
+#endif
+  for (std::ptrdiff_t i = 0; i < num_points; ++i) {
     const pcl::index_t v = tri.point_vertex[i];
     if (v < 0)
       continue;
     if (result_.labels[i] == 0)
-      ++counts.without_normal;
+      ++without_normal;
     else {
-      ++counts.labeled;
-      counts.shared_vertex += (tri.vertex_point[v] != static_cast<pcl::index_t>(i));
+      ++labeled;
+      shared_vertex += (tri.vertex_point[v] != static_cast<pcl::index_t>(i));
     }
   }
+  result_.counts.without_normal += without_normal;
+  result_.counts.labeled += labeled;
+  result_.counts.shared_vertex += shared_vertex;
 }
 
 template <typename PointT>
@@ -373,6 +391,8 @@ SelectiveSegmentation<PointT>::extract(std::vector<pcl::PointIndices>& clusters)
   watch.reset();
   mergeAndLabel();
   clusters.resize(result_.segments.size());
+  for (std::size_t r = 0; r < clusters.size(); ++r)
+    clusters[r].indices.reserve(result_.segments[r].num_points);
   for (std::size_t i = 0; i < result_.labels.size(); ++i)
     if (result_.labels[i] > 0)
       clusters[result_.labels[i] - 1].indices.push_back(static_cast<pcl::index_t>(i));
@@ -424,6 +444,33 @@ SelectiveSegmentation<PointT>::update(const PointCloud& new_points,
   const bool ok = extract(clusters);
   params_ = saved;
   return ok;
+}
+
+template <typename PointT>
+typename SelectiveSegmentation<PointT>::NormalCloud::ConstPtr
+SelectiveSegmentation<PointT>::getPointNormals() const
+{
+  if (normals_)
+    return normals_;
+  const SphericalTriangulation& tri = delaunay_.getTriangulation();
+  if (!input_ || result_.labels.size() != input_->size() ||
+      tri.point_vertex.size() != input_->size() || vertex_normals_.empty())
+    return nullptr;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  auto normals = pcl::make_shared<NormalCloud>(
+      input_->width, input_->height, pcl::Normal(nan, nan, nan, nan));
+  normals->header = input_->header;
+  normals->is_dense = false;
+  const Eigen::Matrix3f to_cloud = sensorToCloud();
+  for (std::size_t i = 0; i < input_->size(); ++i) {
+    const pcl::index_t v = tri.point_vertex[i];
+    if (v < 0 || !vertex_normals_[v].allFinite())
+      continue;
+    (*normals)[i].getNormalVector3fMap() = to_cloud * vertex_normals_[v];
+    (*normals)[i].curvature = 0.0f;
+  }
+  normals_ = normals;
+  return normals_;
 }
 
 template <typename PointT>
