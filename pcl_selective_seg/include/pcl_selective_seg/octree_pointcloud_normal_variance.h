@@ -13,6 +13,7 @@
 #include <pcl/point_types.h>
 
 #include <algorithm>
+#include <limits>
 #include <memory>
 #include <thread>
 #include <vector>
@@ -119,6 +120,7 @@ protected:
     double sum_area = 0.0;
     double sigma_theta = 0.0;
     double sigma_phi = 0.0;
+    bool complete = true; ///< false: sigmas of a prefix only (computeStatistics())
   };
 
   bool isValidPoint(pcl::index_t index) const;
@@ -133,8 +135,13 @@ protected:
    * needed only while computeAdaptiveLeaves() runs. */
   void releaseScratch();
 
-  /** \brief eq. 4-6 over ordered points [begin, end). */
-  NodeStatistics computeStatistics(std::size_t begin, std::size_t end) const;
+  /** \brief eq. 4-6 over ordered points [begin, end). With \a split_above finite,
+   * stops as soon as a sigma over a prefix of the points exceeds it (then the node's
+   * sigma does too: the node splits and needs no more). */
+  NodeStatistics
+  computeStatistics(std::size_t begin,
+                    std::size_t end,
+                    double split_above = std::numeric_limits<double>::infinity()) const;
 
   /** \brief First and one-past-last ordered point under a node. */
   std::pair<std::size_t, std::size_t>

@@ -249,7 +249,8 @@ OctreePointCloudNormalVariance<PointT>::nodeRange(
 template <typename PointT>
 typename OctreePointCloudNormalVariance<PointT>::NodeStatistics
 OctreePointCloudNormalVariance<PointT>::computeStatistics(std::size_t begin,
-                                                          std::size_t end) const
+                                                          std::size_t end,
+                                                          double split_above) const
 {
   NodeStatistics s;
   for (std::size_t k = begin; k < end; ++k) {
@@ -262,15 +263,23 @@ OctreePointCloudNormalVariance<PointT>::computeStatistics(std::size_t begin,
   const double theta_v = std::atan2(mean.x(), mean.z());
   const double phi_v = std::atan2(mean.y(), mean.z());
   double var_theta = 0.0, var_phi = 0.0;
-  for (std::size_t k = begin; k < end; ++k) {
-    const double w = ordered_weights_[k];
-    const double dt = detail::wrapAngle(ordered_theta_[k] - theta_v);
-    const double dp = detail::wrapAngle(ordered_phi_[k] - phi_v);
-    var_theta += w * dt * dt; // eq. 5
-    var_phi += w * dp * dp;
+  for (std::size_t k = begin; k < end;) {
+    for (const std::size_t block_end = std::min(end, k + 256); k < block_end; ++k) {
+      const double w = ordered_weights_[k];
+      const double dt = detail::wrapAngle(ordered_theta_[k] - theta_v);
+      const double dp = detail::wrapAngle(ordered_phi_[k] - phi_v);
+      var_theta += w * dt * dt; // eq. 5
+      var_phi += w * dp * dp;
+    }
+    s.sigma_theta = std::sqrt(var_theta / s.sum_weight);
+    s.sigma_phi = std::sqrt(var_phi / s.sum_weight);
+    // The terms are finite and non-negative (finite weights), so the partial sums never
+    // decrease: once a partial sigma exceeds the threshold the whole one does.
+    if (s.sigma_theta > split_above || s.sigma_phi > split_above) {
+      s.complete = k == end;
+      return s;
+    }
   }
-  s.sigma_theta = std::sqrt(var_theta / s.sum_weight);
-  s.sigma_phi = std::sqrt(var_phi / s.sum_weight);
   return s;
 }
 
@@ -309,6 +318,11 @@ OctreePointCloudNormalVariance<PointT>::computeAdaptiveLeaves(
   orderPoints(this->root_node_);
   computeNormalAngles();
   const std::size_t min_points = std::max<std::size_t>(min_points_to_split, 2);
+  const bool finite_weights =
+      std::all_of(ordered_weights_.begin(), ordered_weights_.end(), [](double w) {
+        return std::isfinite(w);
+      });
+  const double kNever = std::numeric_limits<double>::infinity();
   // Level by level from the root: the statistics of a level's nodes in parallel (each
   // node one sequential pass, so the same sums for any thread count), then the
   // decisions in order. A node splits while sigma_theta or sigma_phi > max_std_dev
@@ -325,9 +339,15 @@ OctreePointCloudNormalVariance<PointT>::computeAdaptiveLeaves(
       const auto range = nodeRange(level[i].node);
       level[i].begin = range.first;
       level[i].end = range.second;
-      stats[i] = computeStatistics(range.first, range.second);
+      // A node that may split needs its sigmas only until one exceeds the threshold.
+      const bool can_split = level[i].node->getNodeType() == pcl::octree::BRANCH_NODE &&
+                             range.second - range.first >= min_points;
+      stats[i] = computeStatistics(range.first,
+                                   range.second,
+                                   can_split && finite_weights ? max_std_dev : kNever);
     }
     next.clear();
+    const std::size_t first_new_leaf = leaves_.size();
     for (std::size_t i = 0; i < level.size(); ++i) {
       const PendingNode& node = level[i];
       const NodeStatistics& s = stats[i];
@@ -350,12 +370,16 @@ OctreePointCloudNormalVariance<PointT>::computeAdaptiveLeaves(
         }
       }
     }
+    // Depth-first order: the leaves' point ranges are disjoint and ordered so; each
+    // level's leaves come in that order.
+    std::inplace_merge(leaves_.begin(),
+                       leaves_.begin() + static_cast<std::ptrdiff_t>(first_new_leaf),
+                       leaves_.end(),
+                       [](const AdaptiveLeaf& a, const AdaptiveLeaf& b) {
+                         return a.begin < b.begin;
+                       });
     level.swap(next);
   }
-  // Depth-first order: the leaves' point ranges are disjoint and ordered so.
-  std::sort(leaves_.begin(),
-            leaves_.end(),
-            [](const AdaptiveLeaf& a, const AdaptiveLeaf& b) { return a.begin < b.begin; });
   // The per-point scratch is not needed any more (the leaves hold their statistics).
   releaseScratch();
 }
