@@ -16,6 +16,7 @@
 #include <utility>
 
 #include "delaunay_2d_backends.h"
+#include "incidence_build.h"
 
 namespace pcl {
 namespace selective_seg {
@@ -661,17 +662,20 @@ computeTriangleNeighbours(const std::vector<Triangle>& triangles,
   // (end vertex, triangle). The half-edge opposite corner i of triangle t runs from
   // t[(i + 1) % 3] to t[(i + 2) % 3]; its twin is the half-edge leaving t[(i + 2) % 3]
   // towards t[(i + 1) % 3].
-  std::vector<std::size_t> offsets(num_vertices + 1, 0);
-  for (const auto& t : triangles)
-    for (const index_t v : t)
-      ++offsets[v + 1];
-  std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
-  std::vector<std::pair<index_t, index_t>> half_edges(3 * triangles.size());
-  std::vector<std::size_t> cursor(offsets.begin(), offsets.end() - 1);
-  for (std::size_t t = 0; t < triangles.size(); ++t)
-    for (std::size_t i = 0; i < 3; ++i)
-      half_edges[cursor[triangles[t][i]]++] = {triangles[t][(i + 1) % 3],
-                                               static_cast<index_t>(t)};
+  std::vector<std::size_t> offsets;
+  std::vector<std::pair<index_t, index_t>> half_edges;
+  detail::buildBuckets<std::pair<index_t, index_t>>(
+      triangles.size(),
+      num_vertices,
+      [&](std::size_t t, auto f) {
+        for (std::size_t i = 0; i < 3; ++i)
+          f(triangles[t][i],
+            std::pair<index_t, index_t>(triangles[t][(i + 1) % 3],
+                                        static_cast<index_t>(t)));
+      },
+      static_cast<int>(std::max(1u, num_threads)),
+      offsets,
+      half_edges);
   neighbours.resize(triangles.size());
   // Each triangle's entries are its own: the same result for any thread count.
 #ifdef _OPENMP

@@ -86,7 +86,8 @@ computeVertexNormals(std::size_t num_vertices,
 {
   // Gathered per vertex over its triangles in increasing order: the same sums, in the
   // same order, whatever the number of threads.
-  const Incidence incident = vertexTriangles(triangles, num_vertices);
+  const Incidence incident =
+      vertexTriangles(triangles, num_vertices, threads(num_threads));
   vertex_areas.assign(num_vertices, 0.0);
   vertex_normals.resize(num_vertices);
 #pragma omp parallel for num_threads(threads(num_threads)) schedule(static)

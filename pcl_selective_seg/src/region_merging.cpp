@@ -7,6 +7,8 @@
 #include <pcl_selective_seg/region_merging.h>
 #include <pcl_selective_seg/spherical_delaunay.h>
 
+#include "incidence_build.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -15,47 +17,28 @@
 namespace pcl {
 namespace selective_seg {
 
-namespace {
-
-/** Compressed incidence lists by a counting sort: groups_of(item, f) calls f(group)
- * for each group of the item; each group lists its items in increasing order. */
-template <typename GroupsOf>
-Incidence
-buildIncidence(std::size_t num_items, std::size_t num_groups, GroupsOf groups_of)
-{
-  Incidence inc;
-  inc.offsets.assign(num_groups + 1, 0);
-  for (std::size_t i = 0; i < num_items; ++i)
-    groups_of(i,
-              [&](pcl::index_t g) { ++inc.offsets[static_cast<std::size_t>(g) + 1]; });
-  std::partial_sum(inc.offsets.begin(), inc.offsets.end(), inc.offsets.begin());
-  inc.items.resize(inc.offsets.back());
-  std::vector<std::size_t> next(inc.offsets.begin(), inc.offsets.end() - 1);
-  for (std::size_t i = 0; i < num_items; ++i)
-    groups_of(i, [&](pcl::index_t g) {
-      inc.items[next[static_cast<std::size_t>(g)]++] = static_cast<pcl::index_t>(i);
-    });
-  return inc;
-}
-
-} // namespace
-
 Incidence
 Incidence::build(const std::vector<pcl::index_t>& group_of, std::size_t num_groups)
 {
-  return buildIncidence(group_of.size(), num_groups, [&](std::size_t i, auto f) {
+  return detail::buildIncidence(group_of.size(), num_groups, [&](std::size_t i, auto f) {
     if (group_of[i] >= 0)
       f(group_of[i]);
   });
 }
 
 Incidence
-vertexTriangles(const std::vector<Triangle>& triangles, std::size_t num_vertices)
+vertexTriangles(const std::vector<Triangle>& triangles,
+                std::size_t num_vertices,
+                int num_threads)
 {
-  return buildIncidence(triangles.size(), num_vertices, [&](std::size_t t, auto f) {
-    for (const auto v : triangles[t])
-      f(v);
-  });
+  return detail::buildIncidence(
+      triangles.size(),
+      num_vertices,
+      [&](std::size_t t, auto f) {
+        for (const auto v : triangles[t])
+          f(v);
+      },
+      num_threads > 0 ? num_threads : static_cast<int>(defaultThreads()));
 }
 
 namespace {
@@ -99,10 +82,13 @@ struct LeafTriangles {
 
   LeafTriangles(const MergeInput& input) : in(input)
   {
-    leaf_triangles = buildIncidence(
-        in.triangles->size(), in.leaf_normals->size(), [&](std::size_t t, auto f) {
+    leaf_triangles = detail::buildIncidence(
+        in.triangles->size(),
+        in.leaf_normals->size(),
+        [&](std::size_t t, auto f) {
           forEachDistinct(leavesOf(static_cast<pcl::index_t>(t)), f);
-        });
+        },
+        in.num_threads > 0 ? in.num_threads : static_cast<int>(defaultThreads()));
   }
 
   /** The leaves of a triangle's vertices (-1: none). */

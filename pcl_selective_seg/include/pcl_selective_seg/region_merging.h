@@ -30,6 +30,9 @@ struct MergeInput {
   const std::vector<std::uint8_t>* triangle_edge_on = nullptr;
   double max_merge_angle = 0.0;         ///< eq. 9 threshold [rad]
   double max_edge_triangle_angle = 0.0; ///< eq. 8 threshold [rad]
+  /** Threads for building the incidence lists (0: all cores); the growth itself is
+   * sequential. The result does not depend on it. */
+  int num_threads = 1;
 };
 
 /** \brief Merge the seed segments (octree leaves) across valid edge triangles.
@@ -91,9 +94,11 @@ struct PCL_EXPORTS Incidence {
                          std::size_t num_groups);
 };
 
-/** \brief Triangles at each vertex, in increasing triangle order. */
+/** \brief Triangles at each vertex, in increasing triangle order.
+ * \param[in] num_threads threads (0: all cores); the result does not depend on it */
 PCL_EXPORTS Incidence vertexTriangles(const std::vector<Triangle>& triangles,
-                                      std::size_t num_vertices);
+                                      std::size_t num_vertices,
+                                      int num_threads = 1);
 
 } // namespace selective_seg
 } // namespace pcl

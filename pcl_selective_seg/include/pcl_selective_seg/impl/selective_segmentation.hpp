@@ -324,6 +324,7 @@ SelectiveSegmentation<PointT>::mergeAndLabel()
   in.triangle_edge_on = &triangle_edge_on_;
   in.max_merge_angle = params_.max_merge_angle;
   in.max_edge_triangle_angle = params_.max_edge_triangle_angle;
+  in.num_threads = numThreads();
   std::vector<pcl::index_t> leaf_segment;
   Vector3fVector segment_normals;
   mergeSeedSegments(in, leaf_segment, segment_normals);
