@@ -191,7 +191,8 @@ protected:
   /** \brief Stage 5: seed merging (eq. 6-10) and the labeled outputs. */
   void mergeAndLabel();
 
-  /** \brief Labels ranked by segment size, per-point labels, segments and clusters. */
+  /** \brief Labels ranked by segment size, per-point labels, segments, and the counts
+   * of labeled, shared-vertex and normal-less points. */
   void rankSegments(const std::vector<pcl::index_t>& vertex_segment,
                     const Vector3fVector& segment_normals,
                     std::vector<std::uint32_t>& segment_label);

@@ -219,16 +219,30 @@ SelectiveSegmentation<PointT>::rankSegments(
     result_.segments[r].num_points = sizes[order[r]];
     result_.segments[r].normal = sensorToCloud() * segment_normals[order[r]];
   }
+  // Per-point labels and the counts of labeled, shared-vertex and normal-less points.
   result_.labels.resize(input_->size());
+  std::size_t without_normal = 0, labeled = 0, shared_vertex = 0;
   const auto num_points = static_cast<std::ptrdiff_t>(input_->size());
 #ifdef _OPENMP
-#pragma omp parallel for num_threads(numThreads()) schedule(static)
+#pragma omp parallel for num_threads(numThreads()) schedule(static)                  \
+    reduction(+ : without_normal, labeled, shared_vertex)
 #endif
   for (std::ptrdiff_t i = 0; i < num_points; ++i) {
     const pcl::index_t v = tri.point_vertex[i];
     result_.labels[i] =
         v >= 0 && vertex_segment[v] >= 0 ? segment_label[vertex_segment[v]] : 0;
+    if (v < 0)
+      continue;
+    if (result_.labels[i] == 0)
+      ++without_normal;
+    else {
+      ++labeled;
+      shared_vertex += (tri.vertex_point[v] != static_cast<pcl::index_t>(i));
+    }
   }
+  result_.counts.without_normal += without_normal;
+  result_.counts.labeled += labeled;
+  result_.counts.shared_vertex += shared_vertex;
 }
 
 template <typename PointT>
@@ -241,13 +255,6 @@ SelectiveSegmentation<PointT>::fillMeshAndLeaves(
   const SphericalTriangulation& tri = delaunay_.getTriangulation();
   SegmentedMesh& mesh = result_.mesh;
   const auto num_triangles = static_cast<std::ptrdiff_t>(tri.triangles.size());
-  mesh.triangles.resize(tri.triangles.size());
-#ifdef _OPENMP
-#pragma omp parallel for num_threads(numThreads()) schedule(static)
-#endif
-  for (std::ptrdiff_t t = 0; t < num_triangles; ++t)
-    for (int i = 0; i < 3; ++i)
-      mesh.triangles[t][i] = tri.vertex_point[tri.triangles[t][i]];
   const Eigen::Matrix3f to_cloud = sensorToCloud();
   Vector3fVector label_normals; // sensor frame, like the triangle normals
   for (const auto& s : result_.segments)
@@ -261,13 +268,18 @@ SelectiveSegmentation<PointT>::fillMeshAndLeaves(
                     mesh.labels,
                     mesh.classes,
                     params_.num_threads);
-  // The triangle normals and areas move into the result (the normals turned to the
-  // cloud frame): the run needs them no more, and they are the largest arrays.
+  // The triangles over input points; the triangle normals and areas move into the
+  // result (the normals turned to the cloud frame): the run needs them no more, and
+  // they are the largest arrays.
+  mesh.triangles.resize(tri.triangles.size());
 #ifdef _OPENMP
 #pragma omp parallel for num_threads(numThreads()) schedule(static)
 #endif
-  for (std::ptrdiff_t t = 0; t < num_triangles; ++t)
+  for (std::ptrdiff_t t = 0; t < num_triangles; ++t) {
+    for (int i = 0; i < 3; ++i)
+      mesh.triangles[t][i] = tri.vertex_point[tri.triangles[t][i]];
     triangle_normals_[t] = to_cloud * triangle_normals_[t];
+  }
   mesh.normals = std::move(triangle_normals_);
   mesh.areas = std::move(triangle_areas_);
   triangle_normals_.clear();
@@ -341,26 +353,6 @@ SelectiveSegmentation<PointT>::mergeAndLabel()
       vertex_labels[v] = segment_label[vertex_segment[v]];
   fillMeshAndLeaves(vertex_labels, leaf_segment, segment_label);
 
-  std::size_t without_normal = 0, labeled = 0, shared_vertex = 0;
-  const auto num_points = static_cast<std::ptrdiff_t>(input_->size());
-#ifdef _OPENMP
-#pragma omp parallel for num_threads(numThreads()) schedule(static)           \
-    reduction(+ : without_normal, labeled, shared_vertex)
-#endif
-  for (std::ptrdiff_t i = 0; i < num_points; ++i) {
-    const pcl::index_t v = tri.point_vertex[i];
-    if (v < 0)
-      continue;
-    if (result_.labels[i] == 0)
-      ++without_normal;
-    else {
-      ++labeled;
-      shared_vertex += (tri.vertex_point[v] != static_cast<pcl::index_t>(i));
-    }
-  }
-  result_.counts.without_normal += without_normal;
-  result_.counts.labeled += labeled;
-  result_.counts.shared_vertex += shared_vertex;
 }
 
 template <typename PointT>

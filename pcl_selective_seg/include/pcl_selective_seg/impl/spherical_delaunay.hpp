@@ -158,26 +158,33 @@ SphericalDelaunay<PointT>::mergeEqualAngles(
     const Eigen::Affine3d& pose,
     SphericalTriangulation& result) const
 {
-  result.vertex_point.clear();
-  result.vertex_angles.clear();
-  result.vertex_positions.clear();
-  for (std::size_t begin = 0; begin < sorted.size();) {
-    std::size_t end = begin + 1;
-    while (end < sorted.size() && sorted[end].first == sorted[begin].first)
-      ++end;
+  // One vertex per run of equal keys; the runs are filled in parallel (a point belongs
+  // to one run, so every entry is written once).
+  std::vector<std::size_t> run_begin;
+  for (std::size_t k = 0; k < sorted.size(); ++k)
+    if (k == 0 || sorted[k].first != sorted[k - 1].first)
+      run_begin.push_back(k);
+  const std::size_t num_vertices = run_begin.size();
+  run_begin.push_back(sorted.size());
+  result.vertex_point.resize(num_vertices);
+  result.vertex_angles.resize(num_vertices);
+  result.vertex_positions.resize(num_vertices);
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(num_threads_) schedule(static)
+#endif
+  for (std::ptrdiff_t v = 0; v < static_cast<std::ptrdiff_t>(num_vertices); ++v) {
+    const std::size_t begin = run_begin[v], end = run_begin[v + 1];
     // The representative: nearest to the sensor, ties by x, y, z, then index; the
     // choice depends on the points only, not on their order.
     pcl::index_t best = sorted[begin].second;
     for (std::size_t k = begin + 1; k < end; ++k)
       if (isCloserRepresentative(pose, sorted[k].second, best))
         best = sorted[k].second;
-    const auto vertex = static_cast<pcl::index_t>(result.vertex_point.size());
-    result.vertex_point.push_back(best);
-    result.vertex_angles.push_back(detail::keyAngles(sorted[begin].first));
-    result.vertex_positions.push_back(toSensorFrame(pose, best).template cast<float>());
+    result.vertex_point[v] = best;
+    result.vertex_angles[v] = detail::keyAngles(sorted[begin].first);
+    result.vertex_positions[v] = toSensorFrame(pose, best).template cast<float>();
     for (std::size_t k = begin; k < end; ++k)
-      result.point_vertex[sorted[k].second] = vertex;
-    begin = end;
+      result.point_vertex[sorted[k].second] = static_cast<pcl::index_t>(v);
   }
 }
 
