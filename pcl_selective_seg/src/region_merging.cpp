@@ -74,8 +74,10 @@ seedOrder(const std::vector<pcl::index_t>& vertex_leaf, std::size_t num_leaves)
   return order;
 }
 
-/** The triangles at each leaf: every triangle listed once under each distinct leaf of
- * its vertices, in increasing triangle order. */
+/** The triangles at each leaf that can matter to the growth: every triangle whose
+ * vertices lie in at least two leaves, listed once under each distinct leaf of its
+ * vertices, in increasing triangle order. A triangle within one leaf is never an edge
+ * triangle of the segment holding that leaf, so leaving it out changes nothing. */
 struct LeafTriangles {
   const MergeInput& in;
   Incidence leaf_triangles;
@@ -86,7 +88,9 @@ struct LeafTriangles {
         in.triangles->size(),
         in.leaf_normals->size(),
         [&](std::size_t t, auto f) {
-          forEachDistinct(leavesOf(static_cast<pcl::index_t>(t)), f);
+          const auto leaves = leavesOf(static_cast<pcl::index_t>(t));
+          if (spansLeaves(leaves))
+            forEachDistinct(leaves, f);
         },
         in.num_threads > 0 ? in.num_threads : static_cast<int>(defaultThreads()));
   }
@@ -97,6 +101,13 @@ struct LeafTriangles {
     const Triangle& tri = (*in.triangles)[t];
     const auto& vertex_leaf = *in.vertex_leaf;
     return {vertex_leaf[tri[0]], vertex_leaf[tri[1]], vertex_leaf[tri[2]]};
+  }
+
+  /** Whether a triangle's vertices lie in at least two distinct leaves. */
+  static bool spansLeaves(const std::array<pcl::index_t, 3>& l)
+  {
+    const pcl::index_t first = l[0] >= 0 ? l[0] : l[1] >= 0 ? l[1] : l[2];
+    return first >= 0 && ((l[1] >= 0 && l[1] != first) || (l[2] >= 0 && l[2] != first));
   }
 
   /** Call f once for each distinct non-negative leaf of a triangle. */
