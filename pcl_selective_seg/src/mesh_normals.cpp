@@ -43,6 +43,54 @@ normalizedOrNaN(const Eigen::Vector3d& sum)
   return Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN());
 }
 
+/** Normal (oriented toward the eye) and area of one triangle; the normal stays NaN
+ * when the triangle is degenerate. */
+inline void
+triangleNormal(const Vector3fVector& positions,
+               const Triangle& triangle,
+               const Eigen::Vector3d& eye,
+               Eigen::Vector3f& normal,
+               double& area)
+{
+  const Eigen::Vector3d a = positions[triangle[0]].cast<double>();
+  const Eigen::Vector3d b = positions[triangle[1]].cast<double>();
+  const Eigen::Vector3d c = positions[triangle[2]].cast<double>();
+  Eigen::Vector3d n = (b - a).cross(c - a);
+  const double twice_area = n.norm();
+  area = 0.5 * twice_area;
+  if (!(twice_area > 0.0) || !std::isfinite(twice_area))
+    return;
+  n /= twice_area;
+  if (n.dot((a + b + c) / 3.0 - eye) > 0.0)
+    n = -n;
+  normal = n.cast<float>();
+}
+
+/** Whether one triangle is seen edge-on (markEdgeOnTriangles()). */
+inline std::uint8_t
+isEdgeOn(const Vector3fVector& positions,
+         const Triangle& triangle,
+         const Eigen::Vector3f& normal,
+         const Eigen::Vector3d& eye,
+         double min_cos)
+{
+  if (!normal.allFinite())
+    return 1;
+  const Eigen::Vector3d centroid = (positions[triangle[0]].cast<double>() +
+                                    positions[triangle[1]].cast<double>() +
+                                    positions[triangle[2]].cast<double>()) /
+                                   3.0;
+  const Eigen::Vector3d sight = (centroid - eye).normalized();
+  return std::abs(sight.dot(normal.cast<double>())) < min_cos;
+}
+
+/** cos of the largest incidence of a surface triangle; 0 disables the test. */
+double
+minIncidenceCos(double max_incidence)
+{
+  return max_incidence >= M_PI / 2.0 ? 0.0 : std::cos(max_incidence);
+}
+
 } // namespace
 
 void
@@ -59,19 +107,31 @@ computeTriangleNormals(const Vector3fVector& positions,
   const Eigen::Vector3d eye = viewpoint.cast<double>();
   const auto n_tri = static_cast<std::ptrdiff_t>(triangles.size());
 #pragma omp parallel for num_threads(threads(num_threads)) schedule(static)
+  for (std::ptrdiff_t t = 0; t < n_tri; ++t)
+    triangleNormal(positions, triangles[t], eye, normals[t], areas[t]);
+}
+
+void
+computeTriangleNormalsAndEdgeOn(const Vector3fVector& positions,
+                                const std::vector<Triangle>& triangles,
+                                const Eigen::Vector3f& viewpoint,
+                                double max_incidence,
+                                Vector3fVector& normals,
+                                std::vector<double>& areas,
+                                std::vector<std::uint8_t>& edge_on,
+                                int num_threads)
+{
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  normals.assign(triangles.size(), Eigen::Vector3f::Constant(nan));
+  areas.assign(triangles.size(), 0.0);
+  edge_on.assign(triangles.size(), 0);
+  const double min_cos = minIncidenceCos(max_incidence);
+  const Eigen::Vector3d eye = viewpoint.cast<double>();
+  const auto n_tri = static_cast<std::ptrdiff_t>(triangles.size());
+#pragma omp parallel for num_threads(threads(num_threads)) schedule(static)
   for (std::ptrdiff_t t = 0; t < n_tri; ++t) {
-    const Eigen::Vector3d a = positions[triangles[t][0]].cast<double>();
-    const Eigen::Vector3d b = positions[triangles[t][1]].cast<double>();
-    const Eigen::Vector3d c = positions[triangles[t][2]].cast<double>();
-    Eigen::Vector3d n = (b - a).cross(c - a);
-    const double twice_area = n.norm();
-    areas[t] = 0.5 * twice_area;
-    if (!(twice_area > 0.0) || !std::isfinite(twice_area))
-      continue;
-    n /= twice_area;
-    if (n.dot((a + b + c) / 3.0 - eye) > 0.0)
-      n = -n;
-    normals[t] = n.cast<float>();
+    triangleNormal(positions, triangles[t], eye, normals[t], areas[t]);
+    edge_on[t] = isEdgeOn(positions, triangles[t], normals[t], eye, min_cos);
   }
 }
 
@@ -175,22 +235,12 @@ markEdgeOnTriangles(const Vector3fVector& positions,
                     int num_threads)
 {
   edge_on.assign(triangles.size(), 0);
-  const double min_cos = max_incidence >= M_PI / 2.0 ? 0.0 : std::cos(max_incidence);
+  const double min_cos = minIncidenceCos(max_incidence);
   const Eigen::Vector3d eye = viewpoint.cast<double>();
   const auto n_tri = static_cast<std::ptrdiff_t>(triangles.size());
 #pragma omp parallel for num_threads(threads(num_threads)) schedule(static)
-  for (std::ptrdiff_t t = 0; t < n_tri; ++t) {
-    if (!normals[t].allFinite()) {
-      edge_on[t] = 1;
-      continue;
-    }
-    const Eigen::Vector3d centroid = (positions[triangles[t][0]].cast<double>() +
-                                      positions[triangles[t][1]].cast<double>() +
-                                      positions[triangles[t][2]].cast<double>()) /
-                                     3.0;
-    const Eigen::Vector3d sight = (centroid - eye).normalized();
-    edge_on[t] = std::abs(sight.dot(normals[t].cast<double>())) < min_cos;
-  }
+  for (std::ptrdiff_t t = 0; t < n_tri; ++t)
+    edge_on[t] = isEdgeOn(positions, triangles[t], normals[t], eye, min_cos);
 }
 
 double

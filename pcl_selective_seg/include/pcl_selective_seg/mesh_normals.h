@@ -111,6 +111,18 @@ PCL_EXPORTS void markEdgeOnTriangles(const Vector3fVector& positions,
                                      std::vector<std::uint8_t>& edge_on,
                                      int num_threads = 0);
 
+/** \brief computeTriangleNormals() and markEdgeOnTriangles() in one pass over the
+ * triangles (the same normals, areas and flags).
+ * \param[in] max_incidence [rad], as markEdgeOnTriangles() */
+PCL_EXPORTS void computeTriangleNormalsAndEdgeOn(const Vector3fVector& positions,
+                                                 const std::vector<Triangle>& triangles,
+                                                 const Eigen::Vector3f& viewpoint,
+                                                 double max_incidence,
+                                                 Vector3fVector& normals,
+                                                 std::vector<double>& areas,
+                                                 std::vector<std::uint8_t>& edge_on,
+                                                 int num_threads = 0);
+
 /** \brief Median 3-D length of the triangles' edges [m] (each interior edge counted
  * twice); 0 for an empty mesh. The octree's automatic minimum voxel size scales it. */
 PCL_EXPORTS double medianEdgeLength(const Vector3fVector& positions,

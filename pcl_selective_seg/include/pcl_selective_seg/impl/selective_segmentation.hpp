@@ -102,19 +102,14 @@ SelectiveSegmentation<PointT>::computeNormals()
   const SphericalTriangulation& tri = delaunay_.getTriangulation();
   const auto& positions = tri.vertex_positions; // sensor frame: the viewpoint is 0
   const Eigen::Vector3f viewpoint = Eigen::Vector3f::Zero();
-  computeTriangleNormals(positions,
-                         tri.triangles,
-                         viewpoint,
-                         triangle_normals_,
-                         triangle_areas_,
-                         params_.num_threads);
-  markEdgeOnTriangles(positions,
-                      tri.triangles,
-                      triangle_normals_,
-                      viewpoint,
-                      params_.max_view_incidence_angle,
-                      triangle_edge_on_,
-                      params_.num_threads);
+  computeTriangleNormalsAndEdgeOn(positions,
+                                  tri.triangles,
+                                  viewpoint,
+                                  params_.max_view_incidence_angle,
+                                  triangle_normals_,
+                                  triangle_areas_,
+                                  triangle_edge_on_,
+                                  params_.num_threads);
   vertex_areas_ = std::make_shared<std::vector<double>>();
   computeVertexNormals(positions.size(),
                        tri.triangles,
