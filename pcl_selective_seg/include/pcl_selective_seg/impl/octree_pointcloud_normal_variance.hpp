@@ -137,7 +137,7 @@ OctreePointCloudNormalVariance<PointT>::addPointsFromInputCloud()
       this->addPointIdx(entry.second);
     return true;
   }
-  detail::radixSortByKey(order, static_cast<int>(3 * depth));
+  detail::radixSortByKey(order, static_cast<int>(3 * depth), num_threads_);
   // The same tree as PCL's point-by-point insertion (addPointIdx()), built along the
   // sorted codes: consecutive voxels share the branches of their common prefix, so
   // each node is created once, from its parent, and each leaf's indices are stored

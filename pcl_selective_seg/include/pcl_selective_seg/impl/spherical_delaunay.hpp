@@ -46,7 +46,8 @@ constexpr std::uint64_t kExcludedKey = ~std::uint64_t(0);
  * relative to the smallest theta and phi (entries with equal keys may come in any
  * order; the callers do not depend on it). */
 inline void
-sortByAngleKey(std::vector<std::pair<std::uint64_t, pcl::index_t>>& entries)
+sortByAngleKey(std::vector<std::pair<std::uint64_t, pcl::index_t>>& entries,
+               unsigned int num_threads = 1)
 {
   if (entries.size() < 2)
     return;
@@ -74,7 +75,7 @@ sortByAngleKey(std::vector<std::pair<std::uint64_t, pcl::index_t>>& entries)
   };
   for (auto& e : entries)
     e.first = pack(e.first);
-  radixSortByKey(entries, bits);
+  radixSortByKey(entries, bits, num_threads);
   for (auto& e : entries)
     e.first = unpack(e.first);
 }
@@ -142,7 +143,7 @@ SphericalDelaunay<PointT>::projectAndMergeVertices(SphericalTriangulation& resul
                                return e.first == detail::kExcludedKey;
                              }),
               keyed.end());
-  detail::sortByAngleKey(keyed);
+  detail::sortByAngleKey(keyed, num_threads_);
   mergeEqualAngles(keyed, pose, result);
   for (const auto v : result.point_vertex) {
     result.num_outside_indices += (v == kOutsideIndices);
