@@ -12,8 +12,12 @@ repo=$(cd "$(dirname "$0")/.." && pwd)
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
+load_before=$(cut -d' ' -f1-3 /proc/loadavg)
 SELSEG_DATA="$shared" "$build/test/selseg_benchmark" \
   --benchmark_out="$work/benchmark.json" --benchmark_out_format=json
+load_after=$(cut -d' ' -f1-3 /proc/loadavg)
+# SELSEG_BENCHMARK_JSON=FILE keeps a copy of the raw results.
+if [ -n "${SELSEG_BENCHMARK_JSON:-}" ]; then cp "$work/benchmark.json" "$SELSEG_BENCHMARK_JSON"; fi
 
 # Peak memory of the command-line tool on the same simulated door scans.
 for n in 10000 46255 300000 1000000 3000000; do
@@ -23,4 +27,5 @@ for n in 10000 46255 300000 1000000 3000000; do
 done
 python3 "$repo/apps/perf_report.py" --benchmark "$work/benchmark.json" \
   --tool "$build/apps/pcl_selective_seg" --scans "$work" \
-  --markdown "$repo/docs/performance.md" --plot "$repo/docs/images/performance_scaling.png"
+  --markdown "$repo/docs/performance.md" --plot "$repo/docs/images/performance_scaling.png" \
+  --load "$load_before" "$load_after"

@@ -12,6 +12,7 @@
 
 #include <cmath>
 #include <limits>
+#include <random>
 #include <vector>
 
 using pcl::selective_seg::computeTriangleNormals;
@@ -350,6 +351,48 @@ TEST(MeshNormals, EdgeOnRightAngleFlagsOnlyDegenerate)
         positions, triangles, normals, Eigen::Vector3f::Zero(), max_incidence, edge_on);
     EXPECT_EQ(edge_on[0], 0);
     EXPECT_EQ(edge_on[1], 1);
+  }
+}
+
+// The one-pass function gives exactly the two passes' normals, areas and flags.
+TEST(MeshNormals, NormalsAndEdgeOnInOnePassMatchTwoPasses)
+{
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> coordinate(-1.f, 1.f);
+  Vector3fVector positions;
+  for (int k = 0; k < 300; ++k)
+    positions.emplace_back(coordinate(rng), coordinate(rng), 2.f + coordinate(rng));
+  positions.push_back(positions[0]); // a degenerate triangle below
+  std::vector<Triangle> triangles;
+  for (int k = 0; k + 2 < 300; ++k)
+    triangles.push_back({k, k + 1, k + 2});
+  triangles.push_back({0, 300, 5});
+  const Eigen::Vector3f eye(0.1f, -0.2f, 0.f);
+  for (const double max_incidence : {60.0 * kDeg, 85.0 * kDeg, M_PI / 2.0}) {
+    SCOPED_TRACE(max_incidence);
+    Vector3fVector normals, fused_normals;
+    std::vector<double> areas, fused_areas;
+    std::vector<std::uint8_t> edge_on, fused_edge_on;
+    computeTriangleNormals(positions, triangles, eye, normals, areas, 2);
+    markEdgeOnTriangles(positions, triangles, normals, eye, max_incidence, edge_on, 2);
+    pcl::selective_seg::computeTriangleNormalsAndEdgeOn(positions,
+                                                        triangles,
+                                                        eye,
+                                                        max_incidence,
+                                                        fused_normals,
+                                                        fused_areas,
+                                                        fused_edge_on,
+                                                        2);
+    ASSERT_EQ(fused_normals.size(), normals.size());
+    for (std::size_t t = 0; t < normals.size(); ++t) {
+      SCOPED_TRACE(t);
+      EXPECT_EQ(normals[t].allFinite(), fused_normals[t].allFinite());
+      if (normals[t].allFinite())
+        EXPECT_TRUE(normals[t] == fused_normals[t]);
+    }
+    EXPECT_EQ(areas, fused_areas);
+    EXPECT_EQ(edge_on, fused_edge_on);
+    EXPECT_EQ(edge_on.back(), 1);
   }
 }
 

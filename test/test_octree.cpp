@@ -9,6 +9,7 @@
 #include <pcl_selective_seg/octree_pointcloud_normal_variance.h>
 
 #include <gtest/gtest.h>
+#include <pcl/octree/octree_pointcloud_pointvector.h>
 #include <pcl/pcl_base.h>
 
 #include <algorithm>
@@ -501,6 +502,50 @@ TEST(OctreePointCloudNormalVariance, InsertionOrderIndependence)
       const auto theirs = leafPoints(*reference_tree, expected[l]);
       EXPECT_EQ(mine, std::set<pcl::index_t>(theirs.begin(), theirs.end()));
     }
+  }
+}
+
+// addPointsFromInputCloud() builds the tree along the sorted Morton codes; it must be
+// the tree PCL's own point-by-point insertion builds: same nodes, same leaf keys, same
+// indices in every leaf container, same counts.
+TEST(OctreePointCloudNormalVariance, SameTreeAsPclInsertion)
+{
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> coordinate(-1.f, 1.f);
+  Scene scene = ridge();
+  for (int k = 0; k < 5000; ++k) // scattered points, some sharing finest voxels
+    scene.add(Eigen::Vector3f(coordinate(rng), coordinate(rng), 3.f + coordinate(rng)),
+              Eigen::Vector3f(0.f, 0.f, -1.f),
+              0.01);
+  scene.add(Eigen::Vector3f(0.f, 0.f, 2.f), Eigen::Vector3f(0.f, 0.f, -1.f), 0.0);
+  for (const double resolution : {0.5, 0.05, 0.003}) {
+    SCOPED_TRACE(resolution);
+    const auto ours = buildOctree(scene, resolution, kPaperThreshold);
+    pcl::IndicesPtr valid(new pcl::Indices);
+    for (pcl::index_t i = 0; i < static_cast<pcl::index_t>(scene.cloud->size()); ++i)
+      if ((*scene.areas)[i] > 0.0) // the invalid point is not inserted
+        valid->push_back(i);
+    pcl::octree::OctreePointCloudPointVector<pcl::PointXYZ> pcl_tree(resolution);
+    pcl_tree.setInputCloud(scene.cloud, valid);
+    double min_x, min_y, min_z, max_x, max_y, max_z;
+    ours->getBoundingBox(min_x, min_y, min_z, max_x, max_y, max_z);
+    pcl_tree.defineBoundingBox(min_x, min_y, min_z, max_x, max_y, max_z);
+    ASSERT_EQ(pcl_tree.getTreeDepth(), ours->getTreeDepth());
+    pcl_tree.addPointsFromInputCloud(); // point by point, in index order
+    EXPECT_EQ(ours->getLeafCount(), pcl_tree.getLeafCount());
+    EXPECT_EQ(ours->getBranchCount(), pcl_tree.getBranchCount());
+    auto mine = ours->leaf_depth_begin();
+    auto theirs = pcl_tree.leaf_depth_begin();
+    std::size_t leaves = 0;
+    for (; mine != ours->leaf_depth_end() && theirs != pcl_tree.leaf_depth_end();
+         ++mine, ++theirs, ++leaves) {
+      ASSERT_EQ(mine.getCurrentOctreeKey(), theirs.getCurrentOctreeKey());
+      ASSERT_EQ(mine.getLeafContainer().getPointIndicesVector(),
+                theirs.getLeafContainer().getPointIndicesVector());
+    }
+    EXPECT_TRUE(mine == ours->leaf_depth_end());
+    EXPECT_TRUE(theirs == pcl_tree.leaf_depth_end());
+    EXPECT_EQ(leaves, pcl_tree.getLeafCount());
   }
 }
 

@@ -23,6 +23,7 @@
 
 #include <cube_scene.h>
 
+using pcl::selective_seg::SegmentationResult;
 using pcl::selective_seg::SelectiveSegmentation;
 using Labeled = pcl::PointCloud<pcl::PointXYZL>;
 
@@ -145,8 +146,9 @@ TEST(SelectiveSegmentation, ShuffledInputGivesIdenticalSegments)
 
 TEST(SelectiveSegmentation, ThreadCountDoesNotChangeTheResult)
 {
-  const auto cloud = cubeScene(20000, 8);
-  std::vector<std::vector<std::uint32_t>> labels;
+  // Large enough for the chunked (per-thread) sorts and incidence lists.
+  const auto cloud = cubeScene(80000, 8);
+  std::vector<SegmentationResult> results;
   for (const int threads : {1, 2, 3}) {
     SelectiveSegmentation<pcl::PointXYZL> seg;
     auto p = seg.getParameters();
@@ -154,10 +156,24 @@ TEST(SelectiveSegmentation, ThreadCountDoesNotChangeTheResult)
     seg.setParameters(p);
     std::vector<pcl::PointIndices> clusters;
     ASSERT_TRUE(segment<pcl::PointXYZL>(cloud, seg, clusters));
-    labels.push_back(seg.getResult().labels);
+    results.push_back(seg.getResult());
   }
-  EXPECT_EQ(labels[0], labels[1]);
-  EXPECT_EQ(labels[0], labels[2]);
+  ASSERT_GT(results[0].mesh.triangles.size(), 65536u);
+  for (const std::size_t k : {1u, 2u}) {
+    SCOPED_TRACE(k + 1);
+    EXPECT_EQ(results[0].labels, results[k].labels);
+    EXPECT_EQ(results[0].mesh.triangles, results[k].mesh.triangles);
+    EXPECT_EQ(results[0].mesh.neighbours, results[k].mesh.neighbours);
+    EXPECT_EQ(results[0].mesh.labels, results[k].mesh.labels);
+    EXPECT_EQ(results[0].mesh.areas, results[k].mesh.areas);
+    ASSERT_EQ(results[0].leaves.size(), results[k].leaves.size());
+    for (std::size_t l = 0; l < results[0].leaves.size(); ++l) {
+      EXPECT_EQ(results[0].leaves[l].sigma_theta, results[k].leaves[l].sigma_theta);
+      EXPECT_EQ(results[0].leaves[l].sigma_phi, results[k].leaves[l].sigma_phi);
+      EXPECT_EQ(results[0].leaves[l].area, results[k].leaves[l].area);
+      EXPECT_TRUE(results[0].leaves[l].normal == results[k].leaves[l].normal);
+    }
+  }
 }
 
 TEST(SelectiveSegmentation, LabelsMeshAndOctreeAgree)

@@ -7,6 +7,7 @@
  *  Sec. III.A).
  */
 
+#include <pcl_selective_seg/impl/radix_sort.hpp>
 #include <pcl_selective_seg/spherical_delaunay.h>
 
 #include <gtest/gtest.h>
@@ -328,6 +329,31 @@ TEST(SphericalDelaunay, BadQuantizationRefused)
   delaunay.setAngleQuantization(1e-3);
   EXPECT_TRUE(delaunay.triangulate());
   EXPECT_EQ(delaunay.getTriangulation().triangles.size(), 8u);
+}
+
+// The radix sort behind the vertex order and the octree's Morton order: stable, and
+// the same order for any thread count.
+TEST(RadixSort, StableAndThreadIndependent)
+{
+  std::mt19937_64 rng(11);
+  for (const int bits : {1, 7, 22, 33, 50, 64}) {
+    SCOPED_TRACE(bits);
+    std::vector<std::pair<std::uint64_t, pcl::index_t>> entries(150000);
+    const std::uint64_t mask = bits == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << bits) - 1;
+    for (std::size_t i = 0; i < entries.size(); ++i) // many equal keys
+      entries[i] = {(rng() % 5000) * 0x9e3779b97f4a7c15ull & mask,
+                    static_cast<pcl::index_t>(i)};
+    auto expected = entries;
+    std::stable_sort(expected.begin(), expected.end(), [](const auto& a, const auto& b) {
+      return a.first < b.first;
+    });
+    for (const unsigned threads : {1u, 2u, 3u}) {
+      SCOPED_TRACE(threads);
+      auto sorted = entries;
+      pcl::selective_seg::detail::radixSortByKey(sorted, bits, threads);
+      EXPECT_TRUE(sorted == expected);
+    }
+  }
 }
 
 TEST(SphericalDelaunay, NeighboursConsistent)

@@ -16,6 +16,7 @@
 #include <utility>
 
 #include "delaunay_2d_backends.h"
+#include "incidence_build.h"
 
 namespace pcl {
 namespace selective_seg {
@@ -654,25 +655,34 @@ delaunay2d(const std::vector<QuantizedPoint>& points,
 void
 computeTriangleNeighbours(const std::vector<Triangle>& triangles,
                           std::size_t num_vertices,
-                          std::vector<Triangle>& neighbours)
+                          std::vector<Triangle>& neighbours,
+                          unsigned int num_threads)
 {
   // Bucket the half-edges by their origin vertex (compressed rows), each stored as
   // (end vertex, triangle). The half-edge opposite corner i of triangle t runs from
   // t[(i + 1) % 3] to t[(i + 2) % 3]; its twin is the half-edge leaving t[(i + 2) % 3]
   // towards t[(i + 1) % 3].
-  std::vector<std::size_t> offsets(num_vertices + 1, 0);
-  for (const auto& t : triangles)
-    for (const index_t v : t)
-      ++offsets[v + 1];
-  std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
-  std::vector<std::pair<index_t, index_t>> half_edges(3 * triangles.size());
-  std::vector<std::size_t> cursor(offsets.begin(), offsets.end() - 1);
-  for (std::size_t t = 0; t < triangles.size(); ++t)
-    for (std::size_t i = 0; i < 3; ++i)
-      half_edges[cursor[triangles[t][i]]++] = {triangles[t][(i + 1) % 3],
-                                               static_cast<index_t>(t)};
-  neighbours.assign(triangles.size(), Triangle{-1, -1, -1});
-  for (std::size_t t = 0; t < triangles.size(); ++t) {
+  std::vector<std::size_t> offsets;
+  std::vector<std::pair<index_t, index_t>> half_edges;
+  detail::buildBuckets<std::pair<index_t, index_t>>(
+      triangles.size(),
+      num_vertices,
+      [&](std::size_t t, auto f) {
+        for (std::size_t i = 0; i < 3; ++i)
+          f(triangles[t][i],
+            std::pair<index_t, index_t>(triangles[t][(i + 1) % 3],
+                                        static_cast<index_t>(t)));
+      },
+      static_cast<int>(std::max(1u, num_threads)),
+      offsets,
+      half_edges);
+  neighbours.resize(triangles.size());
+  // Each triangle's entries are its own: the same result for any thread count.
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(std::max(1u, num_threads)) schedule(static)
+#endif
+  for (std::ptrdiff_t t = 0; t < static_cast<std::ptrdiff_t>(triangles.size()); ++t) {
+    neighbours[t] = Triangle{-1, -1, -1};
     for (std::size_t i = 0; i < 3; ++i) {
       const index_t origin = triangles[t][(i + 1) % 3];
       const index_t end = triangles[t][(i + 2) % 3];

@@ -43,21 +43,21 @@ normalizedOrNaN(const Eigen::Vector3d& sum)
   return Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN());
 }
 
-/** Unit normal toward the eye (NaN when degenerate) and 3-D area of one triangle. */
-void
+/** Normal (oriented toward the eye) and area of one triangle; the normal stays NaN
+ * when the triangle is degenerate. */
+inline void
 triangleNormal(const Vector3fVector& positions,
-               const Triangle& tri,
+               const Triangle& triangle,
                const Eigen::Vector3d& eye,
                Eigen::Vector3f& normal,
                double& area)
 {
-  const Eigen::Vector3d a = positions[tri[0]].cast<double>();
-  const Eigen::Vector3d b = positions[tri[1]].cast<double>();
-  const Eigen::Vector3d c = positions[tri[2]].cast<double>();
+  const Eigen::Vector3d a = positions[triangle[0]].cast<double>();
+  const Eigen::Vector3d b = positions[triangle[1]].cast<double>();
+  const Eigen::Vector3d c = positions[triangle[2]].cast<double>();
   Eigen::Vector3d n = (b - a).cross(c - a);
   const double twice_area = n.norm();
   area = 0.5 * twice_area;
-  normal = Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN());
   if (!(twice_area > 0.0) || !std::isfinite(twice_area))
     return;
   n /= twice_area;
@@ -66,20 +66,20 @@ triangleNormal(const Vector3fVector& positions,
   normal = n.cast<float>();
 }
 
-/** Whether a triangle is seen more obliquely than acos(min_cos), or degenerate. */
-std::uint8_t
-edgeOn(const Vector3fVector& positions,
-       const Triangle& tri,
-       const Eigen::Vector3f& normal,
-       const Eigen::Vector3d& eye,
-       double min_cos)
+/** Whether one triangle is seen edge-on (markEdgeOnTriangles()). */
+inline std::uint8_t
+isEdgeOn(const Vector3fVector& positions,
+         const Triangle& triangle,
+         const Eigen::Vector3f& normal,
+         const Eigen::Vector3d& eye,
+         double min_cos)
 {
   if (!normal.allFinite())
     return 1;
-  const Eigen::Vector3d centroid =
-      (positions[tri[0]].cast<double>() + positions[tri[1]].cast<double>() +
-       positions[tri[2]].cast<double>()) /
-      3.0;
+  const Eigen::Vector3d centroid = (positions[triangle[0]].cast<double>() +
+                                    positions[triangle[1]].cast<double>() +
+                                    positions[triangle[2]].cast<double>()) /
+                                   3.0;
   const Eigen::Vector3d sight = (centroid - eye).normalized();
   return std::abs(sight.dot(normal.cast<double>())) < min_cos;
 }
@@ -106,8 +106,9 @@ vertexNormal(const pcl::index_t* begin,
   vertex_normal = normalizedOrNaN(sum);
 }
 
+/** cos of the largest incidence of a surface triangle; 0 disables the test. */
 double
-minViewCosine(double max_incidence)
+minIncidenceCos(double max_incidence)
 {
   return max_incidence >= M_PI / 2.0 ? 0.0 : std::cos(max_incidence);
 }
@@ -133,6 +134,30 @@ computeTriangleNormals(const Vector3fVector& positions,
 }
 
 void
+computeTriangleNormalsAndEdgeOn(const Vector3fVector& positions,
+                                const std::vector<Triangle>& triangles,
+                                const Eigen::Vector3f& viewpoint,
+                                double max_incidence,
+                                Vector3fVector& normals,
+                                std::vector<double>& areas,
+                                std::vector<std::uint8_t>& edge_on,
+                                int num_threads)
+{
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  normals.assign(triangles.size(), Eigen::Vector3f::Constant(nan));
+  areas.assign(triangles.size(), 0.0);
+  edge_on.assign(triangles.size(), 0);
+  const double min_cos = minIncidenceCos(max_incidence);
+  const Eigen::Vector3d eye = viewpoint.cast<double>();
+  const auto n_tri = static_cast<std::ptrdiff_t>(triangles.size());
+#pragma omp parallel for num_threads(threads(num_threads)) schedule(static)
+  for (std::ptrdiff_t t = 0; t < n_tri; ++t) {
+    triangleNormal(positions, triangles[t], eye, normals[t], areas[t]);
+    edge_on[t] = isEdgeOn(positions, triangles[t], normals[t], eye, min_cos);
+  }
+}
+
+void
 computeVertexNormals(std::size_t num_vertices,
                      const std::vector<Triangle>& triangles,
                      const Vector3fVector& normals,
@@ -143,7 +168,8 @@ computeVertexNormals(std::size_t num_vertices,
 {
   // Gathered per vertex over its triangles in increasing order: the same sums, in the
   // same order, whatever the number of threads.
-  const Incidence incident = vertexTriangles(triangles, num_vertices);
+  const Incidence incident =
+      vertexTriangles(triangles, num_vertices, threads(num_threads));
   vertex_areas.assign(num_vertices, 0.0);
   vertex_normals.resize(num_vertices);
 #pragma omp parallel for num_threads(threads(num_threads)) schedule(static)
@@ -351,37 +377,24 @@ markEdgeOnTriangles(const Vector3fVector& positions,
                     int num_threads)
 {
   edge_on.assign(triangles.size(), 0);
-  const double min_cos = minViewCosine(max_incidence);
+  const double min_cos = minIncidenceCos(max_incidence);
   const Eigen::Vector3d eye = viewpoint.cast<double>();
   const auto n_tri = static_cast<std::ptrdiff_t>(triangles.size());
 #pragma omp parallel for num_threads(threads(num_threads)) schedule(static)
   for (std::ptrdiff_t t = 0; t < n_tri; ++t)
-    edge_on[t] = edgeOn(positions, triangles[t], normals[t], eye, min_cos);
+    edge_on[t] = isEdgeOn(positions, triangles[t], normals[t], eye, min_cos);
 }
 
 void
-updateMeshNormals(const Vector3fVector& positions,
-                  const std::vector<Triangle>& triangles,
-                  const std::vector<Triangle>& neighbours,
-                  const Eigen::Vector3f& viewpoint,
-                  double max_incidence,
-                  const std::vector<pcl::index_t>& changed_triangles,
-                  Vector3fVector& normals,
-                  std::vector<double>& areas,
-                  std::vector<std::uint8_t>& edge_on,
-                  Vector3fVector& vertex_normals,
-                  std::vector<double>& vertex_areas,
-                  int num_threads)
+updateVertexNormals(const std::vector<Triangle>& triangles,
+                    const std::vector<Triangle>& neighbours,
+                    const Vector3fVector& normals,
+                    const std::vector<double>& areas,
+                    const std::vector<pcl::index_t>& changed_triangles,
+                    Vector3fVector& vertex_normals,
+                    std::vector<double>& vertex_areas,
+                    int num_threads)
 {
-  const double min_cos = minViewCosine(max_incidence);
-  const Eigen::Vector3d eye = viewpoint.cast<double>();
-  const auto n_changed = static_cast<std::ptrdiff_t>(changed_triangles.size());
-#pragma omp parallel for num_threads(threads(num_threads)) schedule(static)
-  for (std::ptrdiff_t k = 0; k < n_changed; ++k) {
-    const auto t = changed_triangles[k];
-    triangleNormal(positions, triangles[t], eye, normals[t], areas[t]);
-    edge_on[t] = edgeOn(positions, triangles[t], normals[t], eye, min_cos);
-  }
   // The vertices of the changed triangles, each with one of them.
   std::vector<std::pair<pcl::index_t, pcl::index_t>> touched; // (vertex, triangle)
   touched.reserve(3 * changed_triangles.size());

@@ -5,6 +5,9 @@
  */
 
 #include <pcl_selective_seg/region_merging.h>
+#include <pcl_selective_seg/spherical_delaunay.h>
+
+#include "incidence_build.h"
 
 #include <algorithm>
 #include <array>
@@ -14,47 +17,28 @@
 namespace pcl {
 namespace selective_seg {
 
-namespace {
-
-/** Compressed incidence lists by a counting sort: groups_of(item, f) calls f(group)
- * for each group of the item; each group lists its items in increasing order. */
-template <typename GroupsOf>
-Incidence
-buildIncidence(std::size_t num_items, std::size_t num_groups, GroupsOf groups_of)
-{
-  Incidence inc;
-  inc.offsets.assign(num_groups + 1, 0);
-  for (std::size_t i = 0; i < num_items; ++i)
-    groups_of(i,
-              [&](pcl::index_t g) { ++inc.offsets[static_cast<std::size_t>(g) + 1]; });
-  std::partial_sum(inc.offsets.begin(), inc.offsets.end(), inc.offsets.begin());
-  inc.items.resize(inc.offsets.back());
-  std::vector<std::size_t> next(inc.offsets.begin(), inc.offsets.end() - 1);
-  for (std::size_t i = 0; i < num_items; ++i)
-    groups_of(i, [&](pcl::index_t g) {
-      inc.items[next[static_cast<std::size_t>(g)]++] = static_cast<pcl::index_t>(i);
-    });
-  return inc;
-}
-
-} // namespace
-
 Incidence
 Incidence::build(const std::vector<pcl::index_t>& group_of, std::size_t num_groups)
 {
-  return buildIncidence(group_of.size(), num_groups, [&](std::size_t i, auto f) {
+  return detail::buildIncidence(group_of.size(), num_groups, [&](std::size_t i, auto f) {
     if (group_of[i] >= 0)
       f(group_of[i]);
   });
 }
 
 Incidence
-vertexTriangles(const std::vector<Triangle>& triangles, std::size_t num_vertices)
+vertexTriangles(const std::vector<Triangle>& triangles,
+                std::size_t num_vertices,
+                int num_threads)
 {
-  return buildIncidence(triangles.size(), num_vertices, [&](std::size_t t, auto f) {
-    for (const auto v : triangles[t])
-      f(v);
-  });
+  return detail::buildIncidence(
+      triangles.size(),
+      num_vertices,
+      [&](std::size_t t, auto f) {
+        for (const auto v : triangles[t])
+          f(v);
+      },
+      num_threads > 0 ? num_threads : static_cast<int>(defaultThreads()));
 }
 
 namespace {
@@ -74,40 +58,56 @@ struct GrowingSegment {
   }
 };
 
-/** Seeds, largest first; ties by leaf index. */
+/** Seeds, largest first (number of vertices); ties by leaf index. */
 std::vector<pcl::index_t>
-seedOrder(const Incidence& leaf_vertices)
+seedOrder(const std::vector<pcl::index_t>& vertex_leaf, std::size_t num_leaves)
 {
-  const std::size_t num_leaves = leaf_vertices.offsets.size() - 1;
+  std::vector<std::uint32_t> size(num_leaves, 0);
+  for (const auto l : vertex_leaf)
+    if (l >= 0)
+      ++size[l];
   std::vector<pcl::index_t> order(num_leaves);
   std::iota(order.begin(), order.end(), 0);
-  const auto size = [&](pcl::index_t l) {
-    return leaf_vertices.offsets[l + 1] - leaf_vertices.offsets[l];
-  };
   std::stable_sort(order.begin(), order.end(), [&](pcl::index_t a, pcl::index_t b) {
-    return size(a) > size(b);
+    return size[a] > size[b];
   });
   return order;
 }
 
-/** The leaves of each triangle's vertices (-1: none), and the triangles at each leaf:
- * every triangle listed once under each distinct leaf of its vertices, in increasing
- * triangle order. */
+/** The triangles at each leaf that can matter to the growth: every triangle whose
+ * vertices lie in at least two leaves, listed once under each distinct leaf of its
+ * vertices, in increasing triangle order. A triangle within one leaf is never an edge
+ * triangle of the segment holding that leaf, so leaving it out changes nothing. */
 struct LeafTriangles {
-  std::vector<std::array<pcl::index_t, 3>> triangle_leaves;
+  const MergeInput& in;
   Incidence leaf_triangles;
 
-  LeafTriangles(const MergeInput& in)
+  LeafTriangles(const MergeInput& input) : in(input)
   {
-    const auto& tris = *in.triangles;
-    triangle_leaves.resize(tris.size());
-    for (std::size_t t = 0; t < tris.size(); ++t)
-      for (int i = 0; i < 3; ++i)
-        triangle_leaves[t][i] = (*in.vertex_leaf)[tris[t][i]];
-    leaf_triangles = buildIncidence(
-        tris.size(), in.leaf_normals->size(), [&](std::size_t t, auto f) {
-          forEachDistinct(triangle_leaves[t], f);
-        });
+    leaf_triangles = detail::buildIncidence(
+        in.triangles->size(),
+        in.leaf_normals->size(),
+        [&](std::size_t t, auto f) {
+          const auto leaves = leavesOf(static_cast<pcl::index_t>(t));
+          if (spansLeaves(leaves))
+            forEachDistinct(leaves, f);
+        },
+        in.num_threads > 0 ? in.num_threads : static_cast<int>(defaultThreads()));
+  }
+
+  /** The leaves of a triangle's vertices (-1: none). */
+  std::array<pcl::index_t, 3> leavesOf(pcl::index_t t) const
+  {
+    const Triangle& tri = (*in.triangles)[t];
+    const auto& vertex_leaf = *in.vertex_leaf;
+    return {vertex_leaf[tri[0]], vertex_leaf[tri[1]], vertex_leaf[tri[2]]};
+  }
+
+  /** Whether a triangle's vertices lie in at least two distinct leaves. */
+  static bool spansLeaves(const std::array<pcl::index_t, 3>& l)
+  {
+    const pcl::index_t first = l[0] >= 0 ? l[0] : l[1] >= 0 ? l[1] : l[2];
+    return first >= 0 && ((l[1] >= 0 && l[1] != first) || (l[2] >= 0 && l[2] != first));
   }
 
   /** Call f once for each distinct non-negative leaf of a triangle. */
@@ -127,7 +127,6 @@ class SeedMerger {
 public:
   explicit SeedMerger(const MergeInput& in)
       : in_(in)
-      , leaf_vertices_(Incidence::build(*in.vertex_leaf, in.leaf_normals->size()))
       , adjacency_(in)
       , cos_merge_(std::cos(in.max_merge_angle))
       , cos_edge_(std::cos(in.max_edge_triangle_angle))
@@ -138,7 +137,7 @@ public:
   {
     leaf_segment.assign(in_.leaf_normals->size(), -1);
     segment_normals.clear();
-    for (const auto seed : seedOrder(leaf_vertices_)) {
+    for (const auto seed : seedOrder(*in_.vertex_leaf, in_.leaf_normals->size())) {
       if (leaf_segment[seed] >= 0)
         continue;
       const auto k = static_cast<pcl::index_t>(segment_normals.size());
@@ -169,7 +168,7 @@ private:
                      GrowingSegment& segment,
                      std::vector<pcl::index_t>& leaf_segment)
   {
-    const auto& leaves = adjacency_.triangle_leaves[t];
+    const auto leaves = adjacency_.leavesOf(t);
     const bool edge = std::any_of(leaves.begin(), leaves.end(), [&](pcl::index_t l) {
       return l >= 0 && leaf_segment[l] != k;
     });
@@ -196,7 +195,6 @@ private:
   }
 
   const MergeInput& in_;
-  Incidence leaf_vertices_;
   LeafTriangles adjacency_;
   std::vector<pcl::index_t> queue_;
   double cos_merge_;
@@ -221,12 +219,19 @@ classifyTriangles(const std::vector<Triangle>& triangles,
                   const Vector3fVector& label_normals,
                   double max_edge_triangle_angle,
                   std::vector<std::uint32_t>& labels,
-                  std::vector<TriangleClass>& classes)
+                  std::vector<TriangleClass>& classes,
+                  int num_threads)
 {
   const double cos_edge = std::cos(max_edge_triangle_angle);
   labels.assign(triangles.size(), 0);
   classes.assign(triangles.size(), TriangleClass::InvalidEdge);
-  for (std::size_t t = 0; t < triangles.size(); ++t) {
+  const int threads = num_threads > 0 ? num_threads : static_cast<int>(defaultThreads());
+  const auto num_triangles = static_cast<std::ptrdiff_t>(triangles.size());
+  // Each triangle's label and class are its own: the same for any thread count.
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(threads) schedule(static)
+#endif
+  for (std::ptrdiff_t t = 0; t < num_triangles; ++t) {
     const auto& tri = triangles[t];
     const std::uint32_t l0 = vertex_labels[tri[0]];
     if (l0 != 0 && l0 == vertex_labels[tri[1]] && l0 == vertex_labels[tri[2]]) {

@@ -92,10 +92,12 @@ PCL_EXPORTS bool delaunay2d(const std::vector<QuantizedPoint>& points,
  * oriented. \param[in] num_vertices number of vertices. \param[out] neighbours
  * neighbours[t][i] is the triangle sharing the edge opposite vertex i of triangle t
  * (the edge triangles[t][(i+1)%3] - triangles[t][(i+2)%3]), or -1 on the boundary.
+ * \param[in] num_threads threads for the lookups (the result does not depend on it).
  */
 PCL_EXPORTS void computeTriangleNeighbours(const std::vector<Triangle>& triangles,
                                            std::size_t num_vertices,
-                                           std::vector<Triangle>& neighbours);
+                                           std::vector<Triangle>& neighbours,
+                                           unsigned int num_threads = 1);
 
 } // namespace selective_seg
 } // namespace pcl

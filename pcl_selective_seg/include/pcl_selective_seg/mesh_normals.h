@@ -111,28 +111,36 @@ PCL_EXPORTS void markEdgeOnTriangles(const Vector3fVector& positions,
                                      std::vector<std::uint8_t>& edge_on,
                                      int num_threads = 0);
 
-/** \brief Recompute, after a local change of the mesh, the triangle normals, areas and
- * edge-on flags of the changed triangles and the vertex normals and areas (eq. 2-3) of
- * their vertices; everything else is taken as valid. Gives the values the full
- * functions above (computeTriangleNormals(), markEdgeOnTriangles(),
- * computeVertexNormals()) compute on the whole mesh, bit for bit.
- * \param[in] changed_triangles triangles whose corners or corner positions changed
- * \param[in,out] normals, areas, edge_on per triangle, sized for the mesh
- * \param[in,out] vertex_normals, vertex_areas per vertex, sized for the mesh */
-PCL_EXPORTS void updateMeshNormals(const Vector3fVector& positions,
-                                   const std::vector<Triangle>& triangles,
-                                   const std::vector<Triangle>& neighbours,
-                                   const Eigen::Vector3f& viewpoint,
-                                   double max_incidence,
-                                   const std::vector<pcl::index_t>& changed_triangles,
-                                   Vector3fVector& normals,
-                                   std::vector<double>& areas,
-                                   std::vector<std::uint8_t>& edge_on,
-                                   Vector3fVector& vertex_normals,
-                                   std::vector<double>& vertex_areas,
-                                   int num_threads = 0);
+/** \brief computeTriangleNormals() and markEdgeOnTriangles() in one pass over the
+ * triangles (the same normals, areas and flags).
+ * \param[in] max_incidence [rad], as markEdgeOnTriangles() */
+PCL_EXPORTS void computeTriangleNormalsAndEdgeOn(const Vector3fVector& positions,
+                                                 const std::vector<Triangle>& triangles,
+                                                 const Eigen::Vector3f& viewpoint,
+                                                 double max_incidence,
+                                                 Vector3fVector& normals,
+                                                 std::vector<double>& areas,
+                                                 std::vector<std::uint8_t>& edge_on,
+                                                 int num_threads = 0);
 
-/** \brief After updateMeshNormals(), the k-ring vertex normals (as
+/** \brief Recompute, after a local change of the mesh, the vertex normals and areas
+ * (eq. 2-3) of the changed triangles' vertices, from the triangle normals and areas of
+ * the whole mesh; the other vertices' values are taken as valid. Gives the values
+ * computeVertexNormals() computes on the whole mesh, bit for bit (each vertex's
+ * triangles, found through the adjacency, are summed in increasing order).
+ * \param[in] neighbours the triangle adjacency (computeTriangleNeighbours())
+ * \param[in] changed_triangles triangles whose corners or corner positions changed
+ * \param[in,out] vertex_normals, vertex_areas per vertex, sized for the mesh */
+PCL_EXPORTS void updateVertexNormals(const std::vector<Triangle>& triangles,
+                                     const std::vector<Triangle>& neighbours,
+                                     const Vector3fVector& normals,
+                                     const std::vector<double>& areas,
+                                     const std::vector<pcl::index_t>& changed_triangles,
+                                     Vector3fVector& vertex_normals,
+                                     std::vector<double>& vertex_areas,
+                                     int num_threads = 0);
+
+/** \brief After updateVertexNormals(), the k-ring vertex normals (as
  * computeVertexNormalsOverRings() gives them, bit for bit) of the vertices whose k-ring
  * holds a changed triangle; the others are taken as valid.
  * \param[in,out] vertex_normals per vertex, sized for the mesh */

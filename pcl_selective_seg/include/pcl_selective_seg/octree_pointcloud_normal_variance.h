@@ -13,6 +13,7 @@
 #include <pcl/point_types.h>
 
 #include <algorithm>
+#include <limits>
 #include <memory>
 #include <thread>
 #include <vector>
@@ -119,6 +120,7 @@ protected:
     double sum_area = 0.0;
     double sigma_theta = 0.0;
     double sigma_phi = 0.0;
+    bool complete = true; ///< false: sigmas of a prefix only (computeStatistics())
   };
 
   bool isValidPoint(pcl::index_t index) const;
@@ -129,18 +131,33 @@ protected:
   /** \brief Normals, angles and areas of the ordered points (in parallel). */
   void computeNormalAngles();
 
-  /** \brief eq. 4-6 over ordered points [begin, end). */
-  NodeStatistics computeStatistics(std::size_t begin, std::size_t end) const;
+  /** \brief Frees the per-point normals, angles and weights (computeNormalAngles()),
+   * needed only while computeAdaptiveLeaves() runs. */
+  void releaseScratch();
+
+  /** \brief eq. 4-6 over ordered points [begin, end). With \a split_above finite,
+   * stops as soon as a sigma over a prefix of the points exceeds it (then the node's
+   * sigma does too: the node splits and needs no more). */
+  NodeStatistics
+  computeStatistics(std::size_t begin,
+                    std::size_t end,
+                    double split_above = std::numeric_limits<double>::infinity()) const;
 
   /** \brief First and one-past-last ordered point under a node. */
   std::pair<std::size_t, std::size_t>
   nodeRange(const pcl::octree::OctreeNode* node) const;
 
-  void splitOrKeep(const pcl::octree::OctreeNode* node,
-                   const pcl::octree::OctreeKey& key,
-                   std::uint32_t depth,
-                   double max_std_dev,
-                   std::size_t min_points_to_split);
+  /** \brief A node met while descending from the root, with its point range. */
+  struct PendingNode {
+    const pcl::octree::OctreeNode* node = nullptr;
+    pcl::octree::OctreeKey key;
+    std::uint32_t depth = 0;
+    std::size_t begin = 0;
+    std::size_t end = 0;
+  };
+
+  /** \brief A node kept as a leaf, with its statistics. */
+  AdaptiveLeaf makeLeaf(const PendingNode& node, const NodeStatistics& s) const;
 
 private:
   NormalCloudConstPtr normals_;
@@ -150,7 +167,8 @@ private:
   std::vector<Eigen::Vector3d> ordered_normals_; ///< sensor frame, reversed (eq. 5)
   std::vector<double> ordered_theta_;            ///< angles of ordered_normals_ [rad]
   std::vector<double> ordered_phi_;
-  std::vector<double> ordered_areas_; ///< A_p
+  std::vector<double> ordered_areas_;   ///< A_p
+  std::vector<double> ordered_weights_; ///< 1 / A_p (eq. 4)
   std::vector<AdaptiveLeaf> leaves_;
   unsigned int num_threads_ = std::max(1u, std::thread::hardware_concurrency());
 };

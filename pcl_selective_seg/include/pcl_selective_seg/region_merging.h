@@ -30,6 +30,9 @@ struct MergeInput {
   const std::vector<std::uint8_t>* triangle_edge_on = nullptr;
   double max_merge_angle = 0.0;         ///< eq. 9 threshold [rad]
   double max_edge_triangle_angle = 0.0; ///< eq. 8 threshold [rad]
+  /** Threads for building the incidence lists (0: all cores); the growth itself is
+   * sequential. The result does not depend on it. */
+  int num_threads = 1;
 };
 
 /** \brief Merge the seed segments (octree leaves) across valid edge triangles.
@@ -67,6 +70,7 @@ PCL_EXPORTS void mergeSeedSegments(const MergeInput& input,
  * \param[in] max_edge_triangle_angle [rad]
  * \param[out] labels #T labels (0 when no vertex is labeled)
  * \param[out] classes #T classes
+ * \param[in] num_threads threads (0: all cores); the result does not depend on it
  */
 PCL_EXPORTS void classifyTriangles(const std::vector<Triangle>& triangles,
                                    const Vector3fVector& triangle_normals,
@@ -75,7 +79,8 @@ PCL_EXPORTS void classifyTriangles(const std::vector<Triangle>& triangles,
                                    const Vector3fVector& label_normals,
                                    double max_edge_triangle_angle,
                                    std::vector<std::uint32_t>& labels,
-                                   std::vector<TriangleClass>& classes);
+                                   std::vector<TriangleClass>& classes,
+                                   int num_threads = 1);
 
 /** \brief Compressed incidence lists: the items of group g are
  * items[offsets[g] .. offsets[g + 1]), in increasing item order.
@@ -89,9 +94,11 @@ struct PCL_EXPORTS Incidence {
                          std::size_t num_groups);
 };
 
-/** \brief Triangles at each vertex, in increasing triangle order. */
+/** \brief Triangles at each vertex, in increasing triangle order.
+ * \param[in] num_threads threads (0: all cores); the result does not depend on it */
 PCL_EXPORTS Incidence vertexTriangles(const std::vector<Triangle>& triangles,
-                                      std::size_t num_vertices);
+                                      std::size_t num_vertices,
+                                      int num_threads = 1);
 
 } // namespace selective_seg
 } // namespace pcl

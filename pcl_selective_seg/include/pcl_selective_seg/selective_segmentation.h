@@ -164,15 +164,19 @@ public:
   LabeledCloud::Ptr getLabeledCloud() const;
 
   /** \brief Point normals (eq. 2) in the cloud frame, oriented toward the sensor; same
-   * size and layout as the input; NaN where a point has no normal. */
-  NormalCloud::ConstPtr getPointNormals() const { return normals_; }
+   * size and layout as the input; NaN where a point has no normal. Null before a
+   * successful extract(). Built from the vertex normals on the first call after a run
+   * (the pipeline itself needs only the vertex normals), then kept. */
+  NormalCloud::ConstPtr getPointNormals() const;
 
   /** \brief The segmented mesh over the input cloud (labels and classes per triangle
    * are in getResult().mesh). */
   void getPolygonMesh(pcl::PolygonMesh& mesh) const;
 
   /** \brief The triangulation of the last extract(): the vertex of every input point,
-   * the vertices' representative points, angles and sensor-frame positions. */
+   * the vertices' representative points, angles and sensor-frame positions. Its
+   * neighbours are left empty: the triangle adjacency is getResult().mesh.neighbours
+   * (same triangle order), stored once. */
   const SphericalTriangulation& getTriangulation() const
   {
     return delaunay_.getTriangulation();
@@ -218,13 +222,21 @@ protected:
   /** \brief Stage 5: seed merging (eq. 6-10) and the labeled outputs. */
   void mergeAndLabel();
 
-  /** \brief Labels ranked by segment size, per-point labels, segments and clusters. */
+  /** \brief Labels ranked by segment size, per-point labels, segments, and the counts
+   * of labeled, shared-vertex and normal-less points. */
   void rankSegments(const std::vector<pcl::index_t>& vertex_segment,
                     const Vector3fVector& segment_normals,
                     std::vector<std::uint32_t>& segment_label);
 
   /** \brief The triangle normals eq. 8 tests (parameter edge_triangle_normal). */
   const Vector3fVector& edgeTestNormals();
+
+  /** \brief Threads of the parallel loops (parameter num_threads, 0 = all cores). */
+  int numThreads() const
+  {
+    return params_.num_threads > 0 ? params_.num_threads
+                                   : static_cast<int>(defaultThreads());
+  }
 
   /** \brief Rotation from the sensor frame to the cloud frame. */
   Eigen::Matrix3f sensorToCloud() const { return delaunay_.getSensorPose().rotation(); }
@@ -241,7 +253,7 @@ private:
   SelectiveSegmentationParameters params_;
   SphericalDelaunay<PointT> delaunay_;
   typename Octree::Ptr octree_;
-  NormalCloud::Ptr normals_;
+  mutable NormalCloud::ConstPtr normals_; ///< built by getPointNormals()
   Vector3fVector vertex_normals_; ///< sensor frame
   std::shared_ptr<std::vector<double>> vertex_areas_;
   Vector3fVector triangle_normals_;

@@ -51,7 +51,8 @@ struct SphericalTriangulation {
   std::vector<Eigen::Vector3f> vertex_positions;
   /** #T triangles over vertex ids, counter-clockwise in (theta, phi). */
   std::vector<Triangle> triangles;
-  /** #T triangle across the edge opposite each vertex, -1 on the boundary. */
+  /** #T triangle across the edge opposite each vertex, -1 on the boundary (empty when
+   * SphericalDelaunay::setComputeNeighbours(false)). */
   std::vector<Triangle> neighbours;
   std::size_t num_outside_indices = 0;
   std::size_t num_non_finite = 0;
@@ -87,6 +88,11 @@ public:
   /** \brief Triangulation backend (default: DelaunayBackend::Sweep). */
   void setBackend(DelaunayBackend backend) { backend_ = backend; }
   DelaunayBackend getBackend() const { return backend_; }
+
+  /** \brief Whether triangulate() also fills SphericalTriangulation::neighbours
+   * (default true). */
+  void setComputeNeighbours(bool compute) { compute_neighbours_ = compute; }
+  bool getComputeNeighbours() const { return compute_neighbours_; }
 
   /** \brief Grid step of the angle quantization [rad], in [2.5e-8, 1e-2]. */
   void setAngleQuantization(double step) { angle_quantization_ = step; }
@@ -127,6 +133,9 @@ public:
    * (insertDelaunayPoints()).
    * \param[in] first_new_point the old input's size; the indices must be the old ones
    *            followed by indices of new points
+   * \param[in,out] neighbours the triangle adjacency of the current triangulation
+   *                (computeTriangleNeighbours()); on success that of the new one (also
+   *                stored in the triangulation when setComputeNeighbours(true))
    * \param[out] info the renumbering of the vertices and triangles
    * \param[out] moved_vertices vertices (new ids) whose representative point changed to
    *             a new point nearer to the sensor
@@ -134,6 +143,7 @@ public:
    *         triangles, inconsistent input); the triangulation is then unchanged and
    *         triangulate() should run instead. */
   bool insertPoints(std::size_t first_new_point,
+                    std::vector<Triangle>& neighbours,
                     DelaunayInsertion& info,
                     std::vector<pcl::index_t>& moved_vertices);
 
@@ -177,6 +187,7 @@ private:
   bool has_sensor_pose_ = false;
   SphericalTriangulation triangulation_;
   unsigned int num_threads_ = defaultThreads();
+  bool compute_neighbours_ = true;
 };
 
 } // namespace selective_seg

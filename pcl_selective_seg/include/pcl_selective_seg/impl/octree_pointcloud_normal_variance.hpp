@@ -6,6 +6,7 @@
 
 #pragma once
 
+#include <pcl_selective_seg/impl/radix_sort.hpp>
 #include <pcl_selective_seg/octree_pointcloud_normal_variance.h>
 
 #include <pcl/common/point_tests.h>
@@ -25,12 +26,17 @@ namespace detail {
 inline std::uint64_t
 mortonCode(const pcl::octree::OctreeKey& key)
 {
-  std::uint64_t code = 0;
-  for (unsigned b = 0; b < 21; ++b)
-    code |= (std::uint64_t((key.x >> b) & 1u) << (3 * b + 2)) |
-            (std::uint64_t((key.y >> b) & 1u) << (3 * b + 1)) |
-            (std::uint64_t((key.z >> b) & 1u) << (3 * b));
-  return code;
+  // Spread the low 21 bits of v to every third bit.
+  const auto spread = [](std::uint64_t v) {
+    v &= 0x1fffffu;
+    v = (v | (v << 32)) & 0x1f00000000ffffu;
+    v = (v | (v << 16)) & 0x1f0000ff0000ffu;
+    v = (v | (v << 8)) & 0x100f00f00f00f00fu;
+    v = (v | (v << 4)) & 0x10c30c30c30c30c3u;
+    v = (v | (v << 2)) & 0x1249249249249249u;
+    return v;
+  };
+  return (spread(key.x) << 2) | (spread(key.y) << 1) | spread(key.z);
 }
 
 /** \brief Angle difference wrapped into (-pi, pi]. */
@@ -109,8 +115,10 @@ OctreePointCloudNormalVariance<PointT>::addPointsFromInputCloud()
   // Pad the top so that no point sits exactly on the box's upper faces.
   hi += 0.01 * this->resolution_;
   this->defineBoundingBox(lo.x(), lo.y(), lo.z(), hi.x(), hi.y(), hi.z());
-  // Insert in depth-first (Morton) order of the finest voxels: the tree is walked with
-  // locality, and every leaf receives its points in increasing index order.
+  // Finest voxels in depth-first (Morton) order, points by increasing index within
+  // each (a stable radix sort of the codes of the points in increasing index order).
+  if (!std::is_sorted(valid.begin(), valid.end()))
+    std::sort(valid.begin(), valid.end());
   std::vector<std::pair<std::uint64_t, pcl::index_t>> order(valid.size());
 #ifdef _OPENMP
 #pragma omp parallel for num_threads(num_threads_) schedule(static)
@@ -120,9 +128,53 @@ OctreePointCloudNormalVariance<PointT>::addPointsFromInputCloud()
     this->genOctreeKeyforPoint((*this->input_)[valid[k]], key);
     order[k] = {detail::mortonCode(key), valid[k]};
   }
-  std::sort(order.begin(), order.end());
-  for (const auto& entry : order)
-    this->addPointIdx(entry.second);
+  const auto depth = static_cast<unsigned>(this->octree_depth_);
+  const bool keys_fit =
+      depth <= 21 && std::all_of(order.begin(), order.end(), [&](const auto& entry) {
+        return (entry.first >> (3 * depth)) == 0;
+      });
+  if (this->leaf_count_ != 0 || !keys_fit) {
+    // A tree that already holds points, or keys beyond the tree's depth (extents far
+    // below float epsilon defeat PCL's depth computation): PCL's insertion, point by
+    // point.
+    std::sort(order.begin(), order.end());
+    for (const auto& entry : order)
+      this->addPointIdx(entry.second);
+    return true;
+  }
+  detail::radixSortByKey(order, static_cast<int>(3 * depth), num_threads_);
+  // The same tree as PCL's point-by-point insertion (addPointIdx()), built along the
+  // sorted codes: consecutive voxels share the branches of their common prefix, so
+  // each node is created once, from its parent, and each leaf's indices are stored
+  // with one allocation.
+  std::vector<BranchNode*> path(depth, nullptr);
+  path[0] = this->root_node_;
+  for (std::size_t begin = 0; begin < order.size();) {
+    const std::uint64_t code = order[begin].first;
+    std::size_t end = begin + 1;
+    while (end < order.size() && order[end].first == code)
+      ++end;
+    // The first level whose child differs from the previous voxel's.
+    unsigned level = 0;
+    if (begin > 0) {
+      const std::uint64_t differ = code ^ order[begin - 1].first;
+      level = depth - 1 - static_cast<unsigned>(detail::bitWidth(differ) - 1) / 3;
+    }
+    const auto child = [&](unsigned d) {
+      return static_cast<unsigned char>((code >> (3 * (depth - 1 - d))) & 7u);
+    };
+    for (unsigned d = level; d + 1 < depth; ++d) {
+      path[d + 1] = this->createBranchChild(*path[d], child(d));
+      ++this->branch_count_;
+    }
+    LeafNode* leaf = this->createLeafChild(*path[depth - 1], child(depth - 1));
+    ++this->leaf_count_;
+    auto& indices = leaf->getContainer().getPointIndicesVector();
+    indices.reserve(end - begin);
+    for (std::size_t k = begin; k < end; ++k)
+      indices.push_back(order[k].second);
+    begin = end;
+  }
   return true;
 }
 
@@ -153,6 +205,7 @@ OctreePointCloudNormalVariance<PointT>::computeNormalAngles()
   ordered_theta_.resize(n);
   ordered_phi_.resize(n);
   ordered_areas_.resize(n);
+  ordered_weights_.resize(n);
   const Eigen::Matrix3d to_sensor =
       sensor_orientation_.toRotationMatrix().transpose().template cast<double>();
 #ifdef _OPENMP
@@ -167,6 +220,7 @@ OctreePointCloudNormalVariance<PointT>::computeNormalAngles()
     ordered_theta_[k] = std::atan2(m.x(), m.z());
     ordered_phi_[k] = std::atan2(m.y(), m.z());
     ordered_areas_[k] = (*areas_)[i];
+    ordered_weights_[k] = 1.0 / ordered_areas_[k]; // eq. 4: weight 1 / A_p
   }
 }
 
@@ -200,11 +254,12 @@ OctreePointCloudNormalVariance<PointT>::nodeRange(
 template <typename PointT>
 typename OctreePointCloudNormalVariance<PointT>::NodeStatistics
 OctreePointCloudNormalVariance<PointT>::computeStatistics(std::size_t begin,
-                                                          std::size_t end) const
+                                                          std::size_t end,
+                                                          double split_above) const
 {
   NodeStatistics s;
   for (std::size_t k = begin; k < end; ++k) {
-    const double w = 1.0 / ordered_areas_[k]; // eq. 4: weight 1 / A_p
+    const double w = ordered_weights_[k];
     s.sum_weighted_normal += w * ordered_normals_[k];
     s.sum_weight += w;
     s.sum_area += ordered_areas_[k]; // eq. 6
@@ -213,47 +268,36 @@ OctreePointCloudNormalVariance<PointT>::computeStatistics(std::size_t begin,
   const double theta_v = std::atan2(mean.x(), mean.z());
   const double phi_v = std::atan2(mean.y(), mean.z());
   double var_theta = 0.0, var_phi = 0.0;
-  for (std::size_t k = begin; k < end; ++k) {
-    const double w = 1.0 / ordered_areas_[k];
-    const double dt = detail::wrapAngle(ordered_theta_[k] - theta_v);
-    const double dp = detail::wrapAngle(ordered_phi_[k] - phi_v);
-    var_theta += w * dt * dt; // eq. 5
-    var_phi += w * dp * dp;
+  for (std::size_t k = begin; k < end;) {
+    for (const std::size_t block_end = std::min(end, k + 256); k < block_end; ++k) {
+      const double w = ordered_weights_[k];
+      const double dt = detail::wrapAngle(ordered_theta_[k] - theta_v);
+      const double dp = detail::wrapAngle(ordered_phi_[k] - phi_v);
+      var_theta += w * dt * dt; // eq. 5
+      var_phi += w * dp * dp;
+    }
+    s.sigma_theta = std::sqrt(var_theta / s.sum_weight);
+    s.sigma_phi = std::sqrt(var_phi / s.sum_weight);
+    // The terms are finite and non-negative (finite weights), so the partial sums never
+    // decrease: once a partial sigma exceeds the threshold the whole one does.
+    if (s.sigma_theta > split_above || s.sigma_phi > split_above) {
+      s.complete = k == end;
+      return s;
+    }
   }
-  s.sigma_theta = std::sqrt(var_theta / s.sum_weight);
-  s.sigma_phi = std::sqrt(var_phi / s.sum_weight);
   return s;
 }
 
 template <typename PointT>
-void
-OctreePointCloudNormalVariance<PointT>::splitOrKeep(const pcl::octree::OctreeNode* node,
-                                                    const pcl::octree::OctreeKey& key,
-                                                    std::uint32_t depth,
-                                                    double max_std_dev,
-                                                    std::size_t min_points_to_split)
+AdaptiveLeaf
+OctreePointCloudNormalVariance<PointT>::makeLeaf(const PendingNode& node,
+                                                 const NodeStatistics& s) const
 {
-  const auto range = nodeRange(node);
-  const NodeStatistics s = computeStatistics(range.first, range.second);
-  const bool varies = s.sigma_theta > max_std_dev || s.sigma_phi > max_std_dev;
-  const bool can_split = node->getNodeType() == pcl::octree::BRANCH_NODE &&
-                         range.second - range.first >= min_points_to_split;
-  if (varies && can_split) {
-    const auto* branch = static_cast<const BranchNode*>(node);
-    for (unsigned char c = 0; c < 8; ++c) {
-      if (const auto* child = branch->getChildPtr(c)) {
-        pcl::octree::OctreeKey child_key = key;
-        child_key.pushBranch(c);
-        splitOrKeep(child, child_key, depth + 1, max_std_dev, min_points_to_split);
-      }
-    }
-    return;
-  }
   AdaptiveLeaf leaf;
-  leaf.key = key;
-  leaf.depth = depth;
-  leaf.begin = range.first;
-  leaf.end = range.second;
+  leaf.key = node.key;
+  leaf.depth = node.depth;
+  leaf.begin = node.begin;
+  leaf.end = node.end;
   const Eigen::Matrix3d to_cloud =
       sensor_orientation_.toRotationMatrix().template cast<double>();
   leaf.normal =
@@ -261,7 +305,7 @@ OctreePointCloudNormalVariance<PointT>::splitOrKeep(const pcl::octree::OctreeNod
   leaf.area = s.sum_area;
   leaf.sigma_theta = static_cast<float>(s.sigma_theta);
   leaf.sigma_phi = static_cast<float>(s.sigma_phi);
-  leaves_.push_back(leaf);
+  return leaf;
 }
 
 template <typename PointT>
@@ -271,21 +315,89 @@ OctreePointCloudNormalVariance<PointT>::computeAdaptiveLeaves(
 {
   leaves_.clear();
   ordered_indices_.clear();
-  ordered_normals_.clear();
-  ordered_theta_.clear();
-  ordered_phi_.clear();
-  ordered_areas_.clear();
+  releaseScratch();
   if (this->leaf_count_ == 0 || !this->root_node_)
     return;
   ordered_indices_.reserve(this->indices_ ? this->indices_->size()
                                           : this->input_->size());
   orderPoints(this->root_node_);
   computeNormalAngles();
-  splitOrKeep(this->root_node_,
-              pcl::octree::OctreeKey(),
-              0,
-              max_std_dev,
-              std::max<std::size_t>(min_points_to_split, 2));
+  const std::size_t min_points = std::max<std::size_t>(min_points_to_split, 2);
+  const bool finite_weights =
+      std::all_of(ordered_weights_.begin(), ordered_weights_.end(), [](double w) {
+        return std::isfinite(w);
+      });
+  const double kNever = std::numeric_limits<double>::infinity();
+  // Level by level from the root: the statistics of a level's nodes in parallel (each
+  // node one sequential pass, so the same sums for any thread count), then the
+  // decisions in order. A node splits while sigma_theta or sigma_phi > max_std_dev
+  // (eq. 5) and it is a branch with at least min_points points.
+  std::vector<PendingNode> level(1), next;
+  level[0].node = this->root_node_;
+  std::vector<NodeStatistics> stats;
+  while (!level.empty()) {
+    stats.resize(level.size());
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(num_threads_) schedule(dynamic, 8)
+#endif
+    for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(level.size()); ++i) {
+      const auto range = nodeRange(level[i].node);
+      level[i].begin = range.first;
+      level[i].end = range.second;
+      // A node that may split needs its sigmas only until one exceeds the threshold.
+      const bool can_split = level[i].node->getNodeType() == pcl::octree::BRANCH_NODE &&
+                             range.second - range.first >= min_points;
+      stats[i] = computeStatistics(range.first,
+                                   range.second,
+                                   can_split && finite_weights ? max_std_dev : kNever);
+    }
+    next.clear();
+    const std::size_t first_new_leaf = leaves_.size();
+    for (std::size_t i = 0; i < level.size(); ++i) {
+      const PendingNode& node = level[i];
+      const NodeStatistics& s = stats[i];
+      const bool varies = s.sigma_theta > max_std_dev || s.sigma_phi > max_std_dev;
+      const bool can_split = node.node->getNodeType() == pcl::octree::BRANCH_NODE &&
+                             node.end - node.begin >= min_points;
+      if (!(varies && can_split)) {
+        leaves_.push_back(makeLeaf(node, s));
+        continue;
+      }
+      const auto* branch = static_cast<const BranchNode*>(node.node);
+      for (unsigned char c = 0; c < 8; ++c) {
+        if (const auto* child = branch->getChildPtr(c)) {
+          PendingNode pending;
+          pending.node = child;
+          pending.key = node.key;
+          pending.key.pushBranch(c);
+          pending.depth = node.depth + 1;
+          next.push_back(pending);
+        }
+      }
+    }
+    // Depth-first order: the leaves' point ranges are disjoint and ordered so; each
+    // level's leaves come in that order.
+    std::inplace_merge(leaves_.begin(),
+                       leaves_.begin() + static_cast<std::ptrdiff_t>(first_new_leaf),
+                       leaves_.end(),
+                       [](const AdaptiveLeaf& a, const AdaptiveLeaf& b) {
+                         return a.begin < b.begin;
+                       });
+    level.swap(next);
+  }
+  // The per-point scratch is not needed any more (the leaves hold their statistics).
+  releaseScratch();
+}
+
+template <typename PointT>
+void
+OctreePointCloudNormalVariance<PointT>::releaseScratch()
+{
+  std::vector<Eigen::Vector3d>().swap(ordered_normals_);
+  std::vector<double>().swap(ordered_theta_);
+  std::vector<double>().swap(ordered_phi_);
+  std::vector<double>().swap(ordered_areas_);
+  std::vector<double>().swap(ordered_weights_);
 }
 
 template <typename PointT>

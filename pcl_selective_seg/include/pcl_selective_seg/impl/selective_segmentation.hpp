@@ -67,6 +67,7 @@ SelectiveSegmentation<PointT>::triangulate()
   delaunay_.setBackend(params_.delaunay_backend);
   delaunay_.setAngleQuantization(params_.angle_quantization);
   delaunay_.setNumberOfThreads(static_cast<unsigned int>(params_.num_threads));
+  delaunay_.setComputeNeighbours(false); // computed once, into the result below
   if (!delaunay_.triangulate())
     return fail("extract", "the spherical triangulation failed (reason above)");
   const SphericalTriangulation& tri = delaunay_.getTriangulation();
@@ -121,6 +122,10 @@ SelectiveSegmentation<PointT>::triangulate()
                 "the " + std::to_string(pos.size()) +
                     " distinct points lie on one line in 3-D (to float precision): "
                     "there is no surface to segment");
+  computeTriangleNeighbours(tri.triangles,
+                            tri.vertex_point.size(),
+                            result_.mesh.neighbours,
+                            static_cast<unsigned int>(numThreads()));
   return true;
 }
 
@@ -131,19 +136,14 @@ SelectiveSegmentation<PointT>::computeNormals()
   const SphericalTriangulation& tri = delaunay_.getTriangulation();
   const auto& positions = tri.vertex_positions; // sensor frame: the viewpoint is 0
   const Eigen::Vector3f viewpoint = Eigen::Vector3f::Zero();
-  computeTriangleNormals(positions,
-                         tri.triangles,
-                         viewpoint,
-                         triangle_normals_,
-                         triangle_areas_,
-                         params_.num_threads);
-  markEdgeOnTriangles(positions,
-                      tri.triangles,
-                      triangle_normals_,
-                      viewpoint,
-                      params_.max_view_incidence_angle,
-                      triangle_edge_on_,
-                      params_.num_threads);
+  computeTriangleNormalsAndEdgeOn(positions,
+                                  tri.triangles,
+                                  viewpoint,
+                                  params_.max_view_incidence_angle,
+                                  triangle_normals_,
+                                  triangle_areas_,
+                                  triangle_edge_on_,
+                                  params_.num_threads);
   vertex_areas_ = std::make_shared<std::vector<double>>();
   computeVertexNormals(positions.size(),
                        tri.triangles,
@@ -168,21 +168,13 @@ SelectiveSegmentation<PointT>::publishNormals()
 {
   const SphericalTriangulation& tri = delaunay_.getTriangulation();
   const auto& positions = tri.vertex_positions;
-  const float nan = std::numeric_limits<float>::quiet_NaN();
-  normals_.reset(
-      new NormalCloud(input_->width, input_->height, pcl::Normal(nan, nan, nan, nan)));
-  normals_->header = input_->header;
-  normals_->is_dense = false;
-  const Eigen::Matrix3f to_cloud = sensorToCloud();
-  bool any = false;
-  for (std::size_t i = 0; i < input_->size(); ++i) {
-    const pcl::index_t v = tri.point_vertex[i];
-    if (v < 0 || !vertex_normals_[v].allFinite())
-      continue;
-    (*normals_)[i].getNormalVector3fMap() = to_cloud * vertex_normals_[v];
-    (*normals_)[i].curvature = 0.0f;
-    any = true;
-  }
+  // Every vertex represents at least one point: a point has a normal if a vertex has;
+  // the point normals themselves are built on the first getPointNormals().
+  normals_.reset();
+  const bool any =
+      std::any_of(vertex_normals_.begin(),
+                  vertex_normals_.end(),
+                  [](const Eigen::Vector3f& n) { return n.allFinite(); });
   result_.median_spacing = medianEdgeLength(positions, tri.triangles);
   if (!any)
     return fail("extract",
@@ -274,12 +266,30 @@ SelectiveSegmentation<PointT>::rankSegments(
     result_.segments[r].num_points = sizes[order[r]];
     result_.segments[r].normal = sensorToCloud() * segment_normals[order[r]];
   }
-  result_.labels.assign(input_->size(), 0);
-  for (std::size_t i = 0; i < input_->size(); ++i) {
+  // Per-point labels and the counts of labeled, shared-vertex and normal-less points.
+  result_.labels.resize(input_->size());
+  std::size_t without_normal = 0, labeled = 0, shared_vertex = 0;
+  const auto num_points = static_cast<std::ptrdiff_t>(input_->size());
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(numThreads()) schedule(static)                  \
+    reduction(+ : without_normal, labeled, shared_vertex)
+#endif
+  for (std::ptrdiff_t i = 0; i < num_points; ++i) {
     const pcl::index_t v = tri.point_vertex[i];
-    if (v >= 0 && vertex_segment[v] >= 0)
-      result_.labels[i] = segment_label[vertex_segment[v]];
+    result_.labels[i] =
+        v >= 0 && vertex_segment[v] >= 0 ? segment_label[vertex_segment[v]] : 0;
+    if (v < 0)
+      continue;
+    if (result_.labels[i] == 0)
+      ++without_normal;
+    else {
+      ++labeled;
+      shared_vertex += (tri.vertex_point[v] != static_cast<pcl::index_t>(i));
+    }
   }
+  result_.counts.without_normal += without_normal;
+  result_.counts.labeled += labeled;
+  result_.counts.shared_vertex += shared_vertex;
 }
 
 template <typename PointT>
@@ -291,16 +301,8 @@ SelectiveSegmentation<PointT>::fillMeshAndLeaves(
 {
   const SphericalTriangulation& tri = delaunay_.getTriangulation();
   SegmentedMesh& mesh = result_.mesh;
-  mesh.triangles.resize(tri.triangles.size());
-  for (std::size_t t = 0; t < tri.triangles.size(); ++t)
-    for (int i = 0; i < 3; ++i)
-      mesh.triangles[t][i] = tri.vertex_point[tri.triangles[t][i]];
-  mesh.neighbours = tri.neighbours;
+  const auto num_triangles = static_cast<std::ptrdiff_t>(tri.triangles.size());
   const Eigen::Matrix3f to_cloud = sensorToCloud();
-  mesh.normals.resize(triangle_normals_.size());
-  for (std::size_t t = 0; t < triangle_normals_.size(); ++t)
-    mesh.normals[t] = to_cloud * triangle_normals_[t];
-  mesh.areas = triangle_areas_;
   Vector3fVector label_normals; // sensor frame, like the triangle normals
   for (const auto& s : result_.segments)
     label_normals.push_back(to_cloud.transpose() * s.normal);
@@ -311,7 +313,24 @@ SelectiveSegmentation<PointT>::fillMeshAndLeaves(
                     label_normals,
                     params_.max_edge_triangle_angle,
                     mesh.labels,
-                    mesh.classes);
+                    mesh.classes,
+                    params_.num_threads);
+  // The triangles over input points; the triangle normals and areas move into the
+  // result (the normals turned to the cloud frame): the run needs them no more, and
+  // they are the largest arrays.
+  mesh.triangles.resize(tri.triangles.size());
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(numThreads()) schedule(static)
+#endif
+  for (std::ptrdiff_t t = 0; t < num_triangles; ++t) {
+    for (int i = 0; i < 3; ++i)
+      mesh.triangles[t][i] = tri.vertex_point[tri.triangles[t][i]];
+    triangle_normals_[t] = to_cloud * triangle_normals_[t];
+  }
+  mesh.normals = std::move(triangle_normals_);
+  mesh.areas = std::move(triangle_areas_);
+  triangle_normals_.clear();
+  triangle_areas_.clear();
 
   const auto& leaves = octree_->getAdaptiveLeaves();
   result_.leaves.resize(leaves.size());
@@ -364,6 +383,7 @@ SelectiveSegmentation<PointT>::mergeAndLabel()
   in.triangle_edge_on = &triangle_edge_on_;
   in.max_merge_angle = params_.max_merge_angle;
   in.max_edge_triangle_angle = params_.max_edge_triangle_angle;
+  in.num_threads = numThreads();
   std::vector<pcl::index_t> leaf_segment;
   Vector3fVector segment_normals;
   mergeSeedSegments(in, leaf_segment, segment_normals);
@@ -380,18 +400,6 @@ SelectiveSegmentation<PointT>::mergeAndLabel()
       vertex_labels[v] = segment_label[vertex_segment[v]];
   fillMeshAndLeaves(vertex_labels, leaf_segment, segment_label);
 
-  PointCounts& counts = result_.counts;
-  for (std::size_t i = 0; i < input_->size(); ++i) {
-    const pcl::index_t v = tri.point_vertex[i];
-    if (v < 0)
-      continue;
-    if (result_.labels[i] == 0)
-      ++counts.without_normal;
-    else {
-      ++counts.labeled;
-      counts.shared_vertex += (tri.vertex_point[v] != static_cast<pcl::index_t>(i));
-    }
-  }
 }
 
 template <typename PointT>
@@ -435,6 +443,8 @@ SelectiveSegmentation<PointT>::segmentMesh(std::vector<pcl::PointIndices>& clust
   watch.reset();
   mergeAndLabel();
   clusters.resize(result_.segments.size());
+  for (std::size_t r = 0; r < clusters.size(); ++r)
+    clusters[r].indices.reserve(result_.segments[r].num_points);
   for (std::size_t i = 0; i < result_.labels.size(); ++i)
     if (result_.labels[i] > 0)
       clusters[result_.labels[i] - 1].indices.push_back(static_cast<pcl::index_t>(i));
@@ -446,6 +456,33 @@ SelectiveSegmentation<PointT>::segmentMesh(std::vector<pcl::PointIndices>& clust
              getClassName().c_str());
   this->deinitCompute();
   return true;
+}
+
+template <typename PointT>
+typename SelectiveSegmentation<PointT>::NormalCloud::ConstPtr
+SelectiveSegmentation<PointT>::getPointNormals() const
+{
+  if (normals_)
+    return normals_;
+  const SphericalTriangulation& tri = delaunay_.getTriangulation();
+  if (!input_ || result_.labels.size() != input_->size() ||
+      tri.point_vertex.size() != input_->size() || vertex_normals_.empty())
+    return nullptr;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  auto normals = pcl::make_shared<NormalCloud>(
+      input_->width, input_->height, pcl::Normal(nan, nan, nan, nan));
+  normals->header = input_->header;
+  normals->is_dense = false;
+  const Eigen::Matrix3f to_cloud = sensorToCloud();
+  for (std::size_t i = 0; i < input_->size(); ++i) {
+    const pcl::index_t v = tri.point_vertex[i];
+    if (v < 0 || !vertex_normals_[v].allFinite())
+      continue;
+    (*normals)[i].getNormalVector3fMap() = to_cloud * vertex_normals_[v];
+    (*normals)[i].curvature = 0.0f;
+  }
+  normals_ = normals;
+  return normals_;
 }
 
 template <typename PointT>

@@ -89,13 +89,17 @@ SelectiveSegmentation<PointT>::updateMesh(std::size_t first_new_point, bool& fai
       params_.delaunay_backend != DelaunayBackend::Vtk &&
       mesh_params_.delaunay_backend != DelaunayBackend::Vtk &&
       delaunay_.getSensorPose().matrix() == mesh_pose_ &&
-      triangle_normals_.size() == delaunay_.getTriangulation().triangles.size();
+      result_.mesh.neighbours.size() == delaunay_.getTriangulation().triangles.size() &&
+      vertex_normals_.size() == delaunay_.getTriangulation().vertex_point.size();
   DelaunayInsertion info;
   std::vector<pcl::index_t> moved;
-  if (!same_mesh_parameters || !delaunay_.insertPoints(first_new_point, info, moved)) {
+  if (!same_mesh_parameters ||
+      !delaunay_.insertPoints(first_new_point, result_.mesh.neighbours, info, moved)) {
     this->deinitCompute();
     return false;
   }
+  std::vector<Triangle> adjacency;
+  adjacency.swap(result_.mesh.neighbours);
   const SphericalTriangulation& tri = delaunay_.getTriangulation();
   update_stats_.incremental = true;
   update_stats_.new_vertices = info.inserted_points.size();
@@ -103,6 +107,7 @@ SelectiveSegmentation<PointT>::updateMesh(std::size_t first_new_point, bool& fai
   update_stats_.replaced_triangles = info.replaced_triangles;
   update_stats_.new_triangles = info.new_triangles.size();
   result_.clear();
+  result_.mesh.neighbours.swap(adjacency);
   octree_.reset();
   normals_.reset();
   vertex_mean_normals_.clear();
@@ -128,13 +133,21 @@ SelectiveSegmentation<PointT>::updateNormals(const DelaunayInsertion& info,
                                              const std::vector<pcl::index_t>& moved)
 {
   const SphericalTriangulation& tri = delaunay_.getTriangulation();
+  const std::vector<Triangle>& adjacency = result_.mesh.neighbours;
   const std::size_t num_triangles = tri.triangles.size();
   const std::size_t num_vertices = tri.vertex_positions.size();
-  // Kept triangles keep their normals, unless a corner moved.
-  std::vector<pcl::index_t> source(num_triangles, -1);
-  for (std::size_t t = 0; t < info.old_to_new_triangle.size(); ++t)
-    if (info.old_to_new_triangle[t] >= 0)
-      source[info.old_to_new_triangle[t]] = static_cast<pcl::index_t>(t);
+  // Triangle normals, areas and edge-on flags: one parallel pass over all triangles
+  // (the result keeps the old ones in the cloud frame only). The changed triangles
+  // are the new ones and those at a moved vertex.
+  computeTriangleNormalsAndEdgeOn(tri.vertex_positions,
+                                  tri.triangles,
+                                  Eigen::Vector3f::Zero(),
+                                  params_.max_view_incidence_angle,
+                                  triangle_normals_,
+                                  triangle_areas_,
+                                  triangle_edge_on_,
+                                  params_.num_threads);
+  std::vector<pcl::index_t> changed = info.new_triangles;
   if (!moved.empty()) {
     std::vector<std::uint8_t> is_moved(num_vertices, 0);
     for (const auto v : moved)
@@ -142,46 +155,31 @@ SelectiveSegmentation<PointT>::updateNormals(const DelaunayInsertion& info,
     for (std::size_t t = 0; t < num_triangles; ++t) {
       const Triangle& c = tri.triangles[t];
       if (is_moved[c[0]] || is_moved[c[1]] || is_moved[c[2]])
-        source[t] = -1;
+        changed.push_back(static_cast<pcl::index_t>(t));
     }
+    std::sort(changed.begin(), changed.end());
+    changed.erase(std::unique(changed.begin(), changed.end()), changed.end());
   }
-  Vector3fVector normals(num_triangles);
-  std::vector<double> areas(num_triangles, 0.0);
-  std::vector<std::uint8_t> edge_on(num_triangles, 0);
-  std::vector<pcl::index_t> changed;
-  for (std::size_t t = 0; t < num_triangles; ++t) {
-    const pcl::index_t s = source[t];
-    if (s < 0) {
-      changed.push_back(static_cast<pcl::index_t>(t));
-      continue;
-    }
-    normals[t] = triangle_normals_[s];
-    areas[t] = triangle_areas_[s];
-    edge_on[t] = triangle_edge_on_[s];
-  }
+  // Vertex normals: the old ones renumbered, recomputed at the changed triangles.
   Vector3fVector vertex_normals(num_vertices);
   auto vertex_areas = std::make_shared<std::vector<double>>(num_vertices, 0.0);
   for (std::size_t v = 0; v < info.old_to_new_point.size(); ++v) {
     vertex_normals[info.old_to_new_point[v]] = vertex_normals_[v];
     (*vertex_areas)[info.old_to_new_point[v]] = (*vertex_areas_)[v];
   }
-  updateMeshNormals(tri.vertex_positions,
-                    tri.triangles,
-                    tri.neighbours,
-                    Eigen::Vector3f::Zero(),
-                    params_.max_view_incidence_angle,
-                    changed,
-                    normals,
-                    areas,
-                    edge_on,
-                    vertex_normals,
-                    *vertex_areas,
-                    params_.num_threads);
+  updateVertexNormals(tri.triangles,
+                      adjacency,
+                      triangle_normals_,
+                      triangle_areas_,
+                      changed,
+                      vertex_normals,
+                      *vertex_areas,
+                      params_.num_threads);
   if (params_.normal_rings > 1)
     updateVertexNormalsOverRings(tri.triangles,
-                                 tri.neighbours,
-                                 normals,
-                                 areas,
+                                 adjacency,
+                                 triangle_normals_,
+                                 triangle_areas_,
                                  params_.normal_rings,
                                  changed,
                                  vertex_normals);
@@ -191,9 +189,6 @@ SelectiveSegmentation<PointT>::updateNormals(const DelaunayInsertion& info,
       touched[v] = 1;
   update_stats_.changed_vertices =
       static_cast<std::size_t>(std::count(touched.begin(), touched.end(), 1));
-  triangle_normals_.swap(normals);
-  triangle_areas_.swap(areas);
-  triangle_edge_on_.swap(edge_on);
   vertex_normals_.swap(vertex_normals);
   vertex_areas_ = vertex_areas;
 }

@@ -6,6 +6,7 @@
 
 #pragma once
 
+#include <pcl_selective_seg/impl/radix_sort.hpp>
 #include <pcl_selective_seg/spherical_delaunay.h>
 
 #include <pcl/common/point_tests.h>
@@ -40,6 +41,44 @@ keyAngles(std::uint64_t key)
 
 /** \brief Key of an excluded point (sorts last); its index then holds the status. */
 constexpr std::uint64_t kExcludedKey = ~std::uint64_t(0);
+
+/** \brief Sorts (angle key, point) pairs by key: a radix sort of the keys packed
+ * relative to the smallest theta and phi (entries with equal keys may come in any
+ * order; the callers do not depend on it). */
+inline void
+sortByAngleKey(std::vector<std::pair<std::uint64_t, pcl::index_t>>& entries,
+               unsigned int num_threads = 1)
+{
+  if (entries.size() < 2)
+    return;
+  std::uint32_t lo_theta = ~0u, hi_theta = 0, lo_phi = ~0u, hi_phi = 0;
+  for (const auto& e : entries) {
+    const auto theta = static_cast<std::uint32_t>(e.first >> 32);
+    const auto phi = static_cast<std::uint32_t>(e.first);
+    lo_theta = std::min(lo_theta, theta);
+    hi_theta = std::max(hi_theta, theta);
+    lo_phi = std::min(lo_phi, phi);
+    hi_phi = std::max(hi_phi, phi);
+  }
+  const int phi_bits = bitWidth(hi_phi - lo_phi);
+  const int bits = phi_bits + bitWidth(hi_theta - lo_theta);
+  const auto pack = [&](std::uint64_t key) {
+    return (std::uint64_t{static_cast<std::uint32_t>(key >> 32) - lo_theta}
+            << phi_bits) |
+           (static_cast<std::uint32_t>(key) - lo_phi);
+  };
+  const std::uint64_t phi_mask = (std::uint64_t{1} << phi_bits) - 1;
+  const auto unpack = [&](std::uint64_t packed) {
+    return (std::uint64_t{static_cast<std::uint32_t>(packed >> phi_bits) + lo_theta}
+            << 32) |
+           (static_cast<std::uint32_t>(packed & phi_mask) + lo_phi);
+  };
+  for (auto& e : entries)
+    e.first = pack(e.first);
+  radixSortByKey(entries, bits, num_threads);
+  for (auto& e : entries)
+    e.first = unpack(e.first);
+}
 
 } // namespace detail
 
@@ -104,7 +143,7 @@ SphericalDelaunay<PointT>::projectAndMergeVertices(SphericalTriangulation& resul
                                return e.first == detail::kExcludedKey;
                              }),
               keyed.end());
-  std::sort(keyed.begin(), keyed.end());
+  detail::sortByAngleKey(keyed, num_threads_);
   mergeEqualAngles(keyed, pose, result);
   for (const auto v : result.point_vertex) {
     result.num_outside_indices += (v == kOutsideIndices);
@@ -120,26 +159,33 @@ SphericalDelaunay<PointT>::mergeEqualAngles(
     const Eigen::Affine3d& pose,
     SphericalTriangulation& result) const
 {
-  result.vertex_point.clear();
-  result.vertex_angles.clear();
-  result.vertex_positions.clear();
-  for (std::size_t begin = 0; begin < sorted.size();) {
-    std::size_t end = begin + 1;
-    while (end < sorted.size() && sorted[end].first == sorted[begin].first)
-      ++end;
+  // One vertex per run of equal keys; the runs are filled in parallel (a point belongs
+  // to one run, so every entry is written once).
+  std::vector<std::size_t> run_begin;
+  for (std::size_t k = 0; k < sorted.size(); ++k)
+    if (k == 0 || sorted[k].first != sorted[k - 1].first)
+      run_begin.push_back(k);
+  const std::size_t num_vertices = run_begin.size();
+  run_begin.push_back(sorted.size());
+  result.vertex_point.resize(num_vertices);
+  result.vertex_angles.resize(num_vertices);
+  result.vertex_positions.resize(num_vertices);
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(num_threads_) schedule(static)
+#endif
+  for (std::ptrdiff_t v = 0; v < static_cast<std::ptrdiff_t>(num_vertices); ++v) {
+    const std::size_t begin = run_begin[v], end = run_begin[v + 1];
     // The representative: nearest to the sensor, ties by x, y, z, then index; the
     // choice depends on the points only, not on their order.
     pcl::index_t best = sorted[begin].second;
     for (std::size_t k = begin + 1; k < end; ++k)
       if (isCloserRepresentative(pose, sorted[k].second, best))
         best = sorted[k].second;
-    const auto vertex = static_cast<pcl::index_t>(result.vertex_point.size());
-    result.vertex_point.push_back(best);
-    result.vertex_angles.push_back(detail::keyAngles(sorted[begin].first));
-    result.vertex_positions.push_back(toSensorFrame(pose, best).template cast<float>());
+    result.vertex_point[v] = best;
+    result.vertex_angles[v] = detail::keyAngles(sorted[begin].first);
+    result.vertex_positions[v] = toSensorFrame(pose, best).template cast<float>();
     for (std::size_t k = begin; k < end; ++k)
-      result.point_vertex[sorted[k].second] = vertex;
-    begin = end;
+      result.point_vertex[sorted[k].second] = static_cast<pcl::index_t>(v);
   }
 }
 
@@ -168,9 +214,11 @@ SphericalDelaunay<PointT>::triangulateVertices()
               why.c_str());
     return false;
   }
-  computeTriangleNeighbours(triangulation_.triangles,
-                            triangulation_.vertex_angles.size(),
-                            triangulation_.neighbours);
+  if (compute_neighbours_)
+    computeTriangleNeighbours(triangulation_.triangles,
+                              triangulation_.vertex_angles.size(),
+                              triangulation_.neighbours,
+                              num_threads_);
   return true;
 }
 

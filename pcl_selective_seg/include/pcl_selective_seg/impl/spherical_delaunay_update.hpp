@@ -20,12 +20,13 @@ namespace selective_seg {
 template <typename PointT>
 bool
 SphericalDelaunay<PointT>::insertPoints(std::size_t first_new_point,
+                                        std::vector<Triangle>& neighbours,
                                         DelaunayInsertion& info,
                                         std::vector<pcl::index_t>& moved_vertices)
 {
   moved_vertices.clear();
   SphericalTriangulation& tri = triangulation_;
-  if (!this->input_ || tri.triangles.empty() ||
+  if (!this->input_ || tri.triangles.empty() || neighbours.size() != tri.triangles.size() ||
       tri.point_vertex.size() != first_new_point ||
       first_new_point > this->input_->size() ||
       tri.angle_quantization != angle_quantization_)
@@ -97,11 +98,10 @@ SphericalDelaunay<PointT>::insertPoints(std::size_t first_new_point,
     begin = end;
   }
 
-  std::vector<QuantizedPoint> angles = tri.vertex_angles;
-  std::vector<Triangle> triangles = tri.triangles;
-  std::vector<Triangle> neighbours = tri.neighbours;
+  // The insertion changes its arguments only when it succeeds.
   std::string why;
-  if (!insertDelaunayPoints(angles, triangles, neighbours, new_angles, info, &why)) {
+  if (!insertDelaunayPoints(
+          tri.vertex_angles, tri.triangles, neighbours, new_angles, info, &why)) {
     PCL_DEBUG("[pcl::selective_seg::%s::insertPoints] %s: triangulating again\n",
               getClassName().c_str(),
               why.c_str());
@@ -110,7 +110,7 @@ SphericalDelaunay<PointT>::insertPoints(std::size_t first_new_point,
   }
 
   // Renumber the vertex arrays and the point map.
-  const std::size_t num_vertices = angles.size();
+  const std::size_t num_vertices = tri.vertex_angles.size();
   pcl::Indices vertex_point(num_vertices);
   std::vector<Eigen::Vector3f> positions(num_vertices);
   for (std::size_t v = 0; v < tri.vertex_point.size(); ++v) {
@@ -145,10 +145,11 @@ SphericalDelaunay<PointT>::insertPoints(std::size_t first_new_point,
 
   tri.point_vertex.swap(point_vertex);
   tri.vertex_point.swap(vertex_point);
-  tri.vertex_angles.swap(angles);
   tri.vertex_positions.swap(positions);
-  tri.triangles.swap(triangles);
-  tri.neighbours.swap(neighbours);
+  if (compute_neighbours_)
+    tri.neighbours = neighbours;
+  else
+    tri.neighbours.clear();
   tri.num_outside_indices = tri.num_non_finite = tri.num_behind_sensor = 0;
   for (const auto v : tri.point_vertex) {
     tri.num_outside_indices += (v == kOutsideIndices);

@@ -1,0 +1,105 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
+ */
+
+/* Internal header: the counting sort behind every incidence list (vertex -> triangles,
+ * leaf -> triangles, vertex -> half-edges). Not installed. */
+
+#pragma once
+
+#include <pcl_selective_seg/region_merging.h>
+
+#include <algorithm>
+#include <cstddef>
+#include <vector>
+
+namespace pcl {
+namespace selective_seg {
+namespace detail {
+
+/** \brief Buckets by a counting sort: emit(item, f) calls f(group, value) for each entry
+ * of the item; bucket g is values[offsets[g] .. offsets[g + 1]), its entries in the
+ * order of their items (and of the calls within an item).
+ *
+ * With several threads the items are cut into one consecutive chunk per thread, each
+ * chunk counted and then filled by its thread from its own cursors (a chunk's cursor
+ * for a group starts after the earlier chunks' entries): the same buckets as one
+ * thread gives. */
+template <typename Value, typename Emit>
+void
+buildBuckets(std::size_t num_items,
+             std::size_t num_groups,
+             Emit emit,
+             int num_threads,
+             std::vector<std::size_t>& offsets,
+             std::vector<Value>& values)
+{
+  const std::size_t chunks =
+      num_threads > 1 && num_items >= 65536 ? static_cast<std::size_t>(num_threads) : 1;
+  const std::size_t chunk_size = (num_items + chunks - 1) / chunks;
+  const auto chunk_begin = [&](std::size_t c) {
+    return std::min(num_items, c * chunk_size);
+  };
+  // cursors[c][g]: first the number of entries of group g in chunk c, then where the
+  // chunk's first one goes.
+  std::vector<std::vector<std::size_t>> cursors(chunks,
+                                                std::vector<std::size_t>(num_groups, 0));
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(static_cast<int>(chunks)) schedule(static, 1)
+#endif
+  for (std::ptrdiff_t c = 0; c < static_cast<std::ptrdiff_t>(chunks); ++c) {
+    auto& count = cursors[c];
+    for (std::size_t i = chunk_begin(c); i < chunk_begin(c + 1); ++i)
+      emit(i, [&](pcl::index_t g, const Value&) { ++count[static_cast<std::size_t>(g)]; });
+  }
+  offsets.resize(num_groups + 1);
+  std::size_t total = 0;
+  for (std::size_t g = 0; g < num_groups; ++g) {
+    offsets[g] = total;
+    for (auto& cursor : cursors) {
+      const std::size_t n = cursor[g];
+      cursor[g] = total;
+      total += n;
+    }
+  }
+  offsets[num_groups] = total;
+  values.resize(total);
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(static_cast<int>(chunks)) schedule(static, 1)
+#endif
+  for (std::ptrdiff_t c = 0; c < static_cast<std::ptrdiff_t>(chunks); ++c) {
+    auto& next = cursors[c];
+    for (std::size_t i = chunk_begin(c); i < chunk_begin(c + 1); ++i)
+      emit(i, [&](pcl::index_t g, const Value& value) {
+        values[next[static_cast<std::size_t>(g)]++] = value;
+      });
+  }
+}
+
+/** \brief Compressed incidence lists: groups_of(item, f) calls f(group) for each group
+ * of the item; each group lists its items in increasing order (buildBuckets()). */
+template <typename GroupsOf>
+Incidence
+buildIncidence(std::size_t num_items,
+               std::size_t num_groups,
+               GroupsOf groups_of,
+               int num_threads = 1)
+{
+  Incidence inc;
+  buildBuckets<pcl::index_t>(
+      num_items,
+      num_groups,
+      [&](std::size_t i, auto f) {
+        groups_of(i, [&](pcl::index_t g) { f(g, static_cast<pcl::index_t>(i)); });
+      },
+      num_threads,
+      inc.offsets,
+      inc.items);
+  return inc;
+}
+
+} // namespace detail
+} // namespace selective_seg
+} // namespace pcl
