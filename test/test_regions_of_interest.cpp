@@ -206,7 +206,7 @@ TEST(RegionsOfInterest, EmptyAndMismatchedInput)
                                         RegionOfInterestParameters(),
                                         regions));
   g = makeGrid(10, 6, 0.01, 2);
-  g.tri.neighbours[0][0] = -2;
+  g.result.mesh.neighbours[0][0] = -2;
   EXPECT_FALSE(computeRegionsOfInterest(g.result,
                                         g.tri,
                                         Eigen::Affine3f::Identity(),

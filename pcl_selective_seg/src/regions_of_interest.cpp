@@ -340,7 +340,7 @@ findEvidence(const SegmentationResult& result,
   // a boundary edge longer than twice their own spacing are no evidence.
   for (std::size_t t = 0; t < tri.triangles.size(); ++t)
     for (int k = 0; k < 3; ++k) {
-      if (tri.neighbours[t][k] >= 0)
+      if (result.mesh.neighbours[t][k] >= 0)
         continue;
       const auto a = tri.triangles[t][(k + 1) % 3];
       const auto b = tri.triangles[t][(k + 2) % 3];
@@ -614,7 +614,7 @@ computeRegionsOfInterest(const SegmentationResult& result,
       result.labels.size() != tri.point_vertex.size() ||
       result.mesh.triangles.size() != tri.triangles.size() ||
       result.mesh.classes.size() != tri.triangles.size() ||
-      tri.neighbours.size() != tri.triangles.size() ||
+      result.mesh.neighbours.size() != tri.triangles.size() ||
       !sensor_to_cloud.matrix().allFinite()) {
     PCL_ERROR("[pcl::selective_seg::computeRegionsOfInterest] the segmentation result "
               "(%zu labels, %zu triangles) does not belong to the triangulation (%zu "
@@ -638,7 +638,7 @@ computeRegionsOfInterest(const SegmentationResult& result,
     for (int k = 0; k < 3; ++k)
       if (tri.triangles[t][k] < 0 ||
           static_cast<std::size_t>(tri.triangles[t][k]) >= nv ||
-          tri.neighbours[t][k] < -1 || tri.neighbours[t][k] >= nt) {
+          result.mesh.neighbours[t][k] < -1 || result.mesh.neighbours[t][k] >= nt) {
         PCL_ERROR(
             "[pcl::selective_seg::computeRegionsOfInterest] triangle %zu refers to "
             "a vertex or neighbour out of range\n",
