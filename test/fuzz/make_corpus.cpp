@@ -20,6 +20,8 @@
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
 namespace fs = std::filesystem;
 
 namespace {
@@ -84,7 +86,8 @@ main(int argc, char** argv)
   const fs::path seg_dir = out / "fuzz_segmentation", io_dir = out / "fuzz_scan_io";
   fs::create_directories(seg_dir);
   fs::create_directories(io_dir);
-  const fs::path scratch = fs::temp_directory_path() / "selseg_make_corpus";
+  const fs::path scratch =
+      fs::temp_directory_path() / ("selseg_make_corpus_" + std::to_string(::getpid()));
   fs::create_directories(scratch);
   for (int a = 2; a < argc; ++a) {
     pcl::PointCloud<pcl::PointXYZ> cloud;

@@ -24,6 +24,7 @@
 #include <random>
 #include <set>
 #include <sys/wait.h>
+#include <unistd.h>
 
 namespace fs = std::filesystem;
 using pcl::selective_seg::SelectiveSegmentation;
@@ -130,7 +131,8 @@ TEST(Determinism, ToolOutputsAreByteIdentical)
 {
   if (tool.empty() || !fs::exists(tool) || scan.empty() || !fs::exists(scan))
     GTEST_SKIP() << "tool or scan missing";
-  const fs::path dir = fs::temp_directory_path() / "selseg_determinism";
+  const fs::path dir = fs::temp_directory_path() /
+                       ("selseg_determinism_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   const auto read = [](const fs::path& p) {

@@ -22,6 +22,7 @@
 #include <string>
 #include <sys/resource.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 namespace fs = std::filesystem;
 
@@ -110,9 +111,11 @@ protected:
   {
     if (tool.empty() || !fs::exists(tool) || !fs::exists(scan))
       GTEST_SKIP() << "tool or scan missing";
+    // The process id: several builds may run this suite at once on one machine.
     dir = fs::temp_directory_path() /
           ("selseg_failure_" +
-           std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+           std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) +
+           "_" + std::to_string(::getpid()));
     fs::remove_all(dir);
     fs::create_directories(dir / "in");
     fs::create_directories(dir / "out");
