@@ -88,6 +88,12 @@ expectSameResult(const Seg& seg, const Seg& ref)
   EXPECT_EQ(a.mesh.labels, b.mesh.labels);
   EXPECT_EQ(a.mesh.classes, b.mesh.classes);
   EXPECT_EQ(a.mesh.areas, b.mesh.areas);
+  ASSERT_EQ(a.mesh.normals.size(), b.mesh.normals.size());
+  std::size_t different_normals = 0;
+  for (std::size_t t = 0; t < a.mesh.normals.size(); ++t)
+    for (int k = 0; k < 3; ++k)
+      different_normals += !sameFloat(a.mesh.normals[t][k], b.mesh.normals[t][k]);
+  EXPECT_EQ(different_normals, 0u);
   EXPECT_EQ(a.num_vertices, b.num_vertices);
   EXPECT_EQ(a.median_spacing, b.median_spacing);
   EXPECT_EQ(a.min_voxel_size, b.min_voxel_size);
@@ -334,4 +340,30 @@ TEST(SelectiveSegmentationUpdate, RingNormalsAndVertexMeanEdgeTestAreUpdatedInPl
     reference(scan, voxel, ref);
     expectSameResult(seg, ref);
   }
+}
+
+TEST(SelectiveSegmentationUpdate, RotatedAndMovedSensorGivesTheSameResultAsExtract)
+{
+  // The same scan with the sensor posed in the world: normals and leaves are reported
+  // in the cloud frame, the mesh and its normals kept in the sensor frame.
+  auto scan = toXYZ(*selseg_test::cubeScan(5000, 17));
+  Eigen::Affine3f pose = Eigen::Affine3f::Identity();
+  pose.translate(Eigen::Vector3f(1.0f, -2.0f, 0.5f));
+  pose.rotate(Eigen::AngleAxisf(0.7f, Eigen::Vector3f(0.3f, 1.0f, -0.2f).normalized()));
+  for (auto& p : *scan)
+    p.getVector3fMap() = pose * p.getVector3fMap();
+  scan->sensor_origin_ << pose.translation(), 0.0f;
+  scan->sensor_orientation_ = Eigen::Quaternionf(pose.rotation());
+  const std::size_t split = scan->size() * 3 / 4;
+  auto first = slice(*scan, 0, split);
+  first->sensor_origin_ = scan->sensor_origin_;
+  first->sensor_orientation_ = scan->sensor_orientation_;
+  Seg seg;
+  const double voxel = extractFirst(seg, first);
+  std::vector<pcl::PointIndices> clusters;
+  ASSERT_TRUE(seg.update(*slice(*scan, split, scan->size()), clusters));
+  EXPECT_TRUE(seg.getUpdateStatistics().incremental);
+  Seg ref;
+  reference(scan, voxel, ref);
+  expectSameResult(seg, ref);
 }
