@@ -184,50 +184,63 @@ computeVertexNormals(std::size_t num_vertices,
 
 namespace {
 
-/** The k-ring normal of eq. 2 at vertex p: triangles met breadth first, ring by ring,
- * each vertex's triangles taken in increasing order (incident(v, list) fills them), so
- * the sum has the same order however the incidence is obtained. The stamps mark the
- * vertices and triangles already met for this vertex (stamp: p + 1). */
-template <typename Incident>
-Eigen::Vector3f
-ringNormal(pcl::index_t p,
-           const std::vector<Triangle>& triangles,
-           const Vector3fVector& normals,
-           const std::vector<double>& areas,
-           int rings,
-           Incident incident,
-           std::vector<std::size_t>& vertex_stamp,
-           std::vector<std::size_t>& triangle_stamp,
-           std::vector<pcl::index_t>& frontier,
-           std::vector<pcl::index_t>& next,
-           std::vector<pcl::index_t>& around)
-{
-  const std::size_t stamp = static_cast<std::size_t>(p) + 1;
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  frontier.assign(1, p);
-  vertex_stamp[p] = stamp;
-  for (int ring = 0; ring < rings && !frontier.empty(); ++ring) {
-    next.clear();
-    for (const auto v : frontier) {
-      incident(v, around);
-      for (const auto t : around) {
-        if (triangle_stamp[t] == stamp)
-          continue;
-        triangle_stamp[t] = stamp;
-        const double weight = normalWeight(areas[t], normals[t]);
-        if (weight > 0.0)
-          sum += weight * normals[t].cast<double>();
-        for (const auto u : triangles[t])
-          if (vertex_stamp[u] != stamp) {
-            vertex_stamp[u] = stamp;
-            next.push_back(u);
-          }
+/** The k-ring normal of eq. 2, vertex by vertex: triangles met breadth first, ring by
+ * ring, each vertex's triangles taken in increasing order (incident(v, list) fills
+ * them), so the sum has the same order however the incidence is obtained. Stamps mark
+ * the vertices and triangles already met for the current vertex p (stamp p + 1). */
+class RingNormals {
+public:
+  RingNormals(const std::vector<Triangle>& triangles,
+              const Vector3fVector& normals,
+              const std::vector<double>& areas,
+              std::size_t num_vertices,
+              int rings)
+  : triangles_(triangles)
+  , normals_(normals)
+  , areas_(areas)
+  , rings_(rings)
+  , vertex_stamp_(num_vertices, 0)
+  , triangle_stamp_(triangles.size(), 0)
+  {}
+
+  template <typename Incident>
+  Eigen::Vector3f at(pcl::index_t p, Incident incident)
+  {
+    const std::size_t stamp = static_cast<std::size_t>(p) + 1;
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    frontier_.assign(1, p);
+    vertex_stamp_[p] = stamp;
+    for (int ring = 0; ring < rings_ && !frontier_.empty(); ++ring) {
+      next_.clear();
+      for (const auto v : frontier_) {
+        incident(v, around_);
+        for (const auto t : around_) {
+          if (triangle_stamp_[t] == stamp)
+            continue;
+          triangle_stamp_[t] = stamp;
+          const double weight = normalWeight(areas_[t], normals_[t]);
+          if (weight > 0.0)
+            sum += weight * normals_[t].cast<double>();
+          for (const auto u : triangles_[t])
+            if (vertex_stamp_[u] != stamp) {
+              vertex_stamp_[u] = stamp;
+              next_.push_back(u);
+            }
+        }
       }
+      frontier_.swap(next_);
     }
-    frontier.swap(next);
+    return normalizedOrNaN(sum);
   }
-  return normalizedOrNaN(sum);
-}
+
+private:
+  const std::vector<Triangle>& triangles_;
+  const Vector3fVector& normals_;
+  const std::vector<double>& areas_;
+  int rings_;
+  std::vector<std::size_t> vertex_stamp_, triangle_stamp_;
+  std::vector<pcl::index_t> frontier_, next_, around_;
+};
 
 /** The triangles around vertex v, in increasing order, found by walking the adjacency
  * from one of them (\a first) both ways. */
@@ -266,26 +279,14 @@ computeVertexNormalsOverRings(std::size_t num_vertices,
                               Vector3fVector& vertex_normals)
 {
   const Incidence incident = vertexTriangles(triangles, num_vertices);
-  std::vector<std::size_t> vertex_stamp(num_vertices, 0),
-      triangle_stamp(triangles.size(), 0);
-  std::vector<pcl::index_t> frontier, next, around;
   const auto list = [&](pcl::index_t v, std::vector<pcl::index_t>& out) {
     out.assign(incident.items.begin() + incident.offsets[v],
                incident.items.begin() + incident.offsets[v + 1]);
   };
+  RingNormals ring_normals(triangles, normals, areas, num_vertices, rings);
   vertex_normals.resize(num_vertices);
   for (std::size_t p = 0; p < num_vertices; ++p)
-    vertex_normals[p] = ringNormal(static_cast<pcl::index_t>(p),
-                                   triangles,
-                                   normals,
-                                   areas,
-                                   rings,
-                                   list,
-                                   vertex_stamp,
-                                   triangle_stamp,
-                                   frontier,
-                                   next,
-                                   around);
+    vertex_normals[p] = ring_normals.at(static_cast<pcl::index_t>(p), list);
 }
 
 void
@@ -332,22 +333,10 @@ updateVertexNormalsOverRings(const std::vector<Triangle>& triangles,
         if (some_triangle[u] < 0)
           some_triangle[u] = t;
   };
-  std::vector<std::size_t> vertex_stamp(num_vertices, 0),
-      triangle_stamp(triangles.size(), 0);
-  std::vector<pcl::index_t> around;
+  RingNormals ring_normals(triangles, normals, areas, num_vertices, rings);
   std::sort(affected.begin(), affected.end());
   for (const auto p : affected)
-    vertex_normals[p] = ringNormal(p,
-                                   triangles,
-                                   normals,
-                                   areas,
-                                   rings,
-                                   list,
-                                   vertex_stamp,
-                                   triangle_stamp,
-                                   frontier,
-                                   next,
-                                   around);
+    vertex_normals[p] = ring_normals.at(p, list);
 }
 
 void

@@ -6,6 +6,8 @@
 
 #include <pcl_selective_seg/parameters.h>
 
+#include "parameter_checks.h"
+
 #include <cmath>
 #include <sstream>
 
@@ -16,12 +18,7 @@ namespace {
 bool
 reject(std::string* why, const char* name, double value, const char* range)
 {
-  if (why) {
-    std::ostringstream s;
-    s << "parameter " << name << " = " << value << " is invalid: valid range " << range;
-    *why = s.str();
-  }
-  return false;
+  return detail::rejectParameter(why, name, value, range);
 }
 
 bool

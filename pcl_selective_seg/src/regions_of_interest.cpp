@@ -6,6 +6,8 @@
 
 #include <pcl_selective_seg/regions_of_interest.h>
 
+#include "parameter_checks.h"
+
 #include <pcl/console/print.h>
 
 #include <algorithm>
@@ -28,12 +30,7 @@ constexpr double kEdgeGuard = 1e-6;
 bool
 reject(std::string* why, const char* name, double value, const char* range)
 {
-  if (why) {
-    std::ostringstream s;
-    s << "parameter " << name << " = " << value << " is invalid: valid range " << range;
-    *why = s.str();
-  }
-  return false;
+  return detail::rejectParameter(why, name, value, range);
 }
 
 bool
