@@ -239,17 +239,21 @@ pcdHeaderUsable(const std::string& path, std::string& error)
   return coordinateFieldsUsable(path, header, error);
 }
 
-/** Counts the values the vertex element of a PLY header promises. */
+/** Checks a PLY header line by line before PCL reads it (its parser trusts the header:
+ * a negative element count sends it into a loop of about 2^64 steps) and counts the
+ * values its elements promise. */
 bool
 plyHeaderUsable(const std::string& path, std::string& error)
 {
   std::ifstream in(path, std::ios::binary);
   std::string line;
-  if (!std::getline(in, line) || line.compare(0, 3, "ply") != 0) {
-    error = "cannot read '" + path + "' as PLY: it does not start with 'ply'";
+  const std::string what = "cannot read '" + path + "' as PLY: ";
+  if (!std::getline(in, line) || (line != "ply" && line != "ply\r")) {
+    error = what + "it does not start with a line 'ply'";
     return false;
   }
-  unsigned long long values = 0, count = 0;
+  unsigned long long values = 0;
+  long long count = 0;
   bool in_element = false;
   while (std::getline(in, line)) {
     std::istringstream words(line);
@@ -257,25 +261,32 @@ plyHeaderUsable(const std::string& path, std::string& error)
     words >> keyword;
     if (keyword == "end_header")
       return plausibleSize(path, values, bytesAfter(path, in.tellg()), error);
-    if (keyword == "element") {
-      std::string name;
-      words >> name >> count;
-      if (!words) {
-        error = "cannot read '" + path + "' as PLY: malformed line '" + line + "'";
-        return false;
-      }
+    if (keyword == "comment" || keyword == "obj_info")
+      continue;
+    bool ok = false;
+    if (keyword == "format") {
+      std::string format, version;
+      ok = static_cast<bool>(words >> format >> version) &&
+           (format == "ascii" || format == "binary_little_endian" ||
+            format == "binary_big_endian");
+    }
+    else if (keyword == "element") {
+      std::string name, rest;
+      ok = static_cast<bool>(words >> name >> count) && !(words >> rest) &&
+           count >= 0 && count <= (1ll << 40);
       in_element = true;
     }
     else if (keyword == "property" && in_element) {
-      if (count > (1ull << 40)) {
-        error = "cannot read '" + path + "' as PLY: element count " +
-                std::to_string(count) + " is not plausible";
-        return false;
-      }
-      values += count;
+      std::string type, name;
+      ok = static_cast<bool>(words >> type >> name);
+      values += static_cast<unsigned long long>(count);
+    }
+    if (!ok) {
+      error = what + "malformed or implausible header line '" + line + "'";
+      return false;
     }
   }
-  error = "cannot read '" + path + "' as PLY: its header has no end_header (truncated)";
+  error = what + "its header has no end_header (truncated)";
   return false;
 }
 
