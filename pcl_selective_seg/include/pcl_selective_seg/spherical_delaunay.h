@@ -166,6 +166,22 @@ protected:
                    const Eigen::Affine3d& pose,
                    SphericalTriangulation& result) const;
 
+  /** \brief Eq. 1 for one point: (its quantized angle key, the point), or (a key that
+   * sorts last, its PointStatus) when it is not finite or not in front of the sensor. */
+  std::pair<std::uint64_t, pcl::index_t> projectPoint(const Eigen::Affine3d& pose,
+                                                      pcl::index_t index) const;
+
+  /** \brief The representative of the points sorted[begin, end) (equal angles). */
+  pcl::index_t
+  representative(const std::vector<std::pair<std::uint64_t, pcl::index_t>>& sorted,
+                 std::size_t begin,
+                 std::size_t end,
+                 const Eigen::Affine3d& pose) const;
+
+  /** \brief The counts of points outside the indices, non-finite and behind the sensor
+   * from result.point_vertex. */
+  static void countExcluded(SphericalTriangulation& result);
+
   /** \brief Whether point a represents a shared vertex rather than point b. */
   bool isCloserRepresentative(const Eigen::Affine3d& pose,
                               pcl::index_t a,

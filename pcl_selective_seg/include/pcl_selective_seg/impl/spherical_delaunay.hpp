@@ -116,22 +116,8 @@ SphericalDelaunay<PointT>::projectAndMergeVertices(SphericalTriangulation& resul
 #ifdef _OPENMP
 #pragma omp parallel for num_threads(num_threads_) schedule(static)
 #endif
-  for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(indices.size()); ++k) {
-    const pcl::index_t i = indices[k];
-    keyed[k] = {detail::kExcludedKey, kNonFinite};
-    if (!pcl::isXYZFinite(cloud[i]))
-      continue;
-    const Eigen::Vector3d s = toSensorFrame(pose, i);
-    keyed[k].second = kBehindSensor;
-    if (!(s.z() > 0.0))
-      continue;
-    // eq. 1; both angles lie in (-pi/2, pi/2) because z > 0.
-    const QuantizedPoint q{static_cast<std::int32_t>(std::lround(
-                               std::atan2(s.x(), s.z()) / angle_quantization_)),
-                           static_cast<std::int32_t>(std::lround(
-                               std::atan2(s.y(), s.z()) / angle_quantization_))};
-    keyed[k] = {detail::angleKey(q), i};
-  }
+  for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(indices.size()); ++k)
+    keyed[k] = projectPoint(pose, indices[k]);
   result.point_vertex.assign(cloud.size(), kOutsideIndices);
   result.angle_quantization = angle_quantization_;
   for (std::size_t k = 0; k < keyed.size(); ++k)
@@ -145,6 +131,50 @@ SphericalDelaunay<PointT>::projectAndMergeVertices(SphericalTriangulation& resul
               keyed.end());
   detail::sortByAngleKey(keyed, num_threads_);
   mergeEqualAngles(keyed, pose, result);
+  countExcluded(result);
+}
+
+template <typename PointT>
+std::pair<std::uint64_t, pcl::index_t>
+SphericalDelaunay<PointT>::projectPoint(const Eigen::Affine3d& pose,
+                                        pcl::index_t index) const
+{
+  if (!pcl::isXYZFinite((*this->input_)[index]))
+    return {detail::kExcludedKey, kNonFinite};
+  const Eigen::Vector3d s = toSensorFrame(pose, index);
+  if (!(s.z() > 0.0))
+    return {detail::kExcludedKey, kBehindSensor};
+  // eq. 1; both angles lie in (-pi/2, pi/2) because z > 0.
+  const QuantizedPoint q{
+      static_cast<std::int32_t>(
+          std::lround(std::atan2(s.x(), s.z()) / angle_quantization_)),
+      static_cast<std::int32_t>(
+          std::lround(std::atan2(s.y(), s.z()) / angle_quantization_))};
+  return {detail::angleKey(q), index};
+}
+
+template <typename PointT>
+pcl::index_t
+SphericalDelaunay<PointT>::representative(
+    const std::vector<std::pair<std::uint64_t, pcl::index_t>>& sorted,
+    std::size_t begin,
+    std::size_t end,
+    const Eigen::Affine3d& pose) const
+{
+  // Nearest to the sensor, ties by x, y, z, then index: the choice depends on the
+  // points only, not on their order.
+  pcl::index_t best = sorted[begin].second;
+  for (std::size_t k = begin + 1; k < end; ++k)
+    if (isCloserRepresentative(pose, sorted[k].second, best))
+      best = sorted[k].second;
+  return best;
+}
+
+template <typename PointT>
+void
+SphericalDelaunay<PointT>::countExcluded(SphericalTriangulation& result)
+{
+  result.num_outside_indices = result.num_non_finite = result.num_behind_sensor = 0;
   for (const auto v : result.point_vertex) {
     result.num_outside_indices += (v == kOutsideIndices);
     result.num_non_finite += (v == kNonFinite);
@@ -175,12 +205,7 @@ SphericalDelaunay<PointT>::mergeEqualAngles(
 #endif
   for (std::ptrdiff_t v = 0; v < static_cast<std::ptrdiff_t>(num_vertices); ++v) {
     const std::size_t begin = run_begin[v], end = run_begin[v + 1];
-    // The representative: nearest to the sensor, ties by x, y, z, then index; the
-    // choice depends on the points only, not on their order.
-    pcl::index_t best = sorted[begin].second;
-    for (std::size_t k = begin + 1; k < end; ++k)
-      if (isCloserRepresentative(pose, sorted[k].second, best))
-        best = sorted[k].second;
+    const pcl::index_t best = representative(sorted, begin, end, pose);
     result.vertex_point[v] = best;
     result.vertex_angles[v] = detail::keyAngles(sorted[begin].first);
     result.vertex_positions[v] = toSensorFrame(pose, best).template cast<float>();

@@ -8,7 +8,6 @@
 
 #include <pcl_selective_seg/spherical_delaunay.h>
 
-#include <pcl/common/point_tests.h>
 #include <pcl/console/print.h>
 
 #include <algorithm>
@@ -38,7 +37,7 @@ SphericalDelaunay<PointT>::insertPoints(std::size_t first_new_point,
   const auto n = static_cast<pcl::index_t>(cloud.size());
   const Eigen::Affine3d pose = getSensorPose().template cast<double>();
 
-  // The new points' angles, as projectAndMergeVertices() computes them.
+  // The new points' angles.
   std::vector<std::pair<std::uint64_t, pcl::index_t>> keyed;
   std::vector<std::pair<pcl::index_t, pcl::index_t>> excluded; // (point, status)
   for (const pcl::index_t i : indices) {
@@ -48,20 +47,11 @@ SphericalDelaunay<PointT>::insertPoints(std::size_t first_new_point,
     }
     if (static_cast<std::size_t>(i) < first_new_point)
       continue;
-    if (!pcl::isXYZFinite(cloud[i])) {
-      excluded.emplace_back(i, kNonFinite);
-      continue;
-    }
-    const Eigen::Vector3d s = toSensorFrame(pose, i);
-    if (!(s.z() > 0.0)) {
-      excluded.emplace_back(i, kBehindSensor);
-      continue;
-    }
-    const QuantizedPoint q{static_cast<std::int32_t>(std::lround(
-                               std::atan2(s.x(), s.z()) / angle_quantization_)),
-                           static_cast<std::int32_t>(std::lround(
-                               std::atan2(s.y(), s.z()) / angle_quantization_))};
-    keyed.emplace_back(detail::angleKey(q), i);
+    const auto entry = projectPoint(pose, i);
+    if (entry.first == detail::kExcludedKey)
+      excluded.emplace_back(i, entry.second);
+    else
+      keyed.push_back(entry);
   }
   std::sort(keyed.begin(), keyed.end());
 
@@ -77,10 +67,7 @@ SphericalDelaunay<PointT>::insertPoints(std::size_t first_new_point,
       ++end;
     const QuantizedPoint q = detail::keyAngles(keyed[begin].first);
     const auto it = std::lower_bound(tri.vertex_angles.begin(), tri.vertex_angles.end(), q);
-    pcl::index_t best = keyed[begin].second;
-    for (std::size_t k = begin + 1; k < end; ++k)
-      if (isCloserRepresentative(pose, keyed[k].second, best))
-        best = keyed[k].second;
+    const pcl::index_t best = representative(keyed, begin, end, pose);
     if (it != tri.vertex_angles.end() && *it == q) {
       const auto v = static_cast<pcl::index_t>(it - tri.vertex_angles.begin());
       for (std::size_t k = begin; k < end; ++k)
@@ -150,12 +137,7 @@ SphericalDelaunay<PointT>::insertPoints(std::size_t first_new_point,
     tri.neighbours = neighbours;
   else
     tri.neighbours.clear();
-  tri.num_outside_indices = tri.num_non_finite = tri.num_behind_sensor = 0;
-  for (const auto v : tri.point_vertex) {
-    tri.num_outside_indices += (v == kOutsideIndices);
-    tri.num_non_finite += (v == kNonFinite);
-    tri.num_behind_sensor += (v == kBehindSensor);
-  }
+  countExcluded(tri);
   this->deinitCompute();
   return true;
 }
