@@ -195,6 +195,13 @@ protected:
 
   std::string getClassName() const { return "SelectiveSegmentation"; }
 
+  /** \brief Empty result, octree, point normals and edge-test normals. */
+  void clearOutputs();
+
+  /** \brief The point counts and the vertex count of the triangulation, into the
+   * result. */
+  void takeTriangulationCounts();
+
   /** \brief Stage 1-2: spherical projection and Delaunay triangulation. */
   bool triangulate();
 

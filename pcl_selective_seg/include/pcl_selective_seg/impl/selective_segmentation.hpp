@@ -59,6 +59,27 @@ SelectiveSegmentation<PointT>::fail(const char* stage, const std::string& why)
 }
 
 template <typename PointT>
+void
+SelectiveSegmentation<PointT>::clearOutputs()
+{
+  result_.clear();
+  octree_.reset();
+  normals_.reset();
+  vertex_mean_normals_.clear();
+}
+
+template <typename PointT>
+void
+SelectiveSegmentation<PointT>::takeTriangulationCounts()
+{
+  const SphericalTriangulation& tri = delaunay_.getTriangulation();
+  result_.counts.outside_indices = tri.num_outside_indices;
+  result_.counts.non_finite = tri.num_non_finite;
+  result_.counts.behind_sensor = tri.num_behind_sensor;
+  result_.num_vertices = tri.vertex_point.size();
+}
+
+template <typename PointT>
 bool
 SelectiveSegmentation<PointT>::triangulate()
 {
@@ -71,10 +92,7 @@ SelectiveSegmentation<PointT>::triangulate()
   if (!delaunay_.triangulate())
     return fail("extract", "the spherical triangulation failed (reason above)");
   const SphericalTriangulation& tri = delaunay_.getTriangulation();
-  result_.counts.outside_indices = tri.num_outside_indices;
-  result_.counts.non_finite = tri.num_non_finite;
-  result_.counts.behind_sensor = tri.num_behind_sensor;
-  result_.num_vertices = tri.vertex_point.size();
+  takeTriangulationCounts();
   if (tri.vertex_point.empty())
     return fail("extract",
                 "no usable point among " + std::to_string(input_->size()) + ": " +
@@ -407,10 +425,7 @@ bool
 SelectiveSegmentation<PointT>::extract(std::vector<pcl::PointIndices>& clusters)
 {
   clusters.clear();
-  result_.clear();
-  octree_.reset();
-  normals_.reset();
-  vertex_mean_normals_.clear();
+  clearOutputs();
   pcl::StopWatch total;
   if (!initCompute()) {
     this->deinitCompute();

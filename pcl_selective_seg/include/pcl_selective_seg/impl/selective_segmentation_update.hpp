@@ -100,21 +100,14 @@ SelectiveSegmentation<PointT>::updateMesh(std::size_t first_new_point, bool& fai
   }
   std::vector<Triangle> adjacency;
   adjacency.swap(result_.mesh.neighbours);
-  const SphericalTriangulation& tri = delaunay_.getTriangulation();
   update_stats_.incremental = true;
   update_stats_.new_vertices = info.inserted_points.size();
   update_stats_.moved_vertices = moved.size();
   update_stats_.replaced_triangles = info.replaced_triangles;
   update_stats_.new_triangles = info.new_triangles.size();
-  result_.clear();
+  clearOutputs();
   result_.mesh.neighbours.swap(adjacency);
-  octree_.reset();
-  normals_.reset();
-  vertex_mean_normals_.clear();
-  result_.counts.outside_indices = tri.num_outside_indices;
-  result_.counts.non_finite = tri.num_non_finite;
-  result_.counts.behind_sensor = tri.num_behind_sensor;
-  result_.num_vertices = tri.vertex_point.size();
+  takeTriangulationCounts();
   result_.timings.delaunay = watch.getTimeSeconds();
   watch.reset();
   updateNormals(info, moved);
