@@ -13,7 +13,6 @@
 // apps/run_benchmarks.sh runs it and writes docs/performance.md.
 
 #include <pcl_selective_seg/selective_segmentation.h>
-#include <pcl_selective_seg/sensor_simulator.h>
 
 #include <benchmark/benchmark.h>
 #include <pcl/features/normal_3d_omp.h>
@@ -25,6 +24,8 @@
 #include <map>
 #include <string>
 
+#include "door_scan.h"
+
 namespace {
 
 using Cloud = pcl::PointCloud<pcl::PointXYZ>;
@@ -33,22 +34,10 @@ using Cloud = pcl::PointCloud<pcl::PointXYZ>;
 Cloud::ConstPtr
 doorScan(std::size_t n)
 {
-  namespace sim = pcl::selective_seg::simulation;
   static std::map<std::size_t, Cloud::ConstPtr> cache;
   auto& cloud = cache[n];
-  if (!cloud) {
-    const double density =
-        static_cast<double>(n) / sim::getPaperPointCount(sim::PaperScene::Door);
-    auto setup = sim::makeDoorScene(density);
-    setup.sensor.density_ratio = 10.0;
-    sim::SensorSimulator simulator;
-    simulator.setParameters(setup.sensor);
-    pcl::PointCloud<pcl::PointXYZL> labeled;
-    simulator.simulate(setup.scene, labeled);
-    auto xyz = pcl::make_shared<Cloud>();
-    pcl::copyPointCloud(labeled, *xyz);
-    cloud = xyz;
-  }
+  if (!cloud)
+    cloud = selseg_bench::doorScan(n);
   return cloud;
 }
 

@@ -11,34 +11,17 @@
 // (docs/selective_sensing.md). Run: build/test/selseg_benchmark_update
 
 #include <pcl_selective_seg/selective_segmentation.h>
-#include <pcl_selective_seg/sensor_simulator.h>
 
 #include <benchmark/benchmark.h>
-#include <pcl/common/io.h>
 
 #include <cmath>
 #include <map>
 
+#include "door_scan.h"
+
 namespace {
 
 using Cloud = pcl::PointCloud<pcl::PointXYZ>;
-namespace sim = pcl::selective_seg::simulation;
-
-Cloud::Ptr
-doorScan(std::size_t n, unsigned seed)
-{
-  auto setup = sim::makeDoorScene(static_cast<double>(n) /
-                                  sim::getPaperPointCount(sim::PaperScene::Door));
-  setup.sensor.density_ratio = 10.0;
-  setup.sensor.seed = seed;
-  sim::SensorSimulator simulator;
-  simulator.setParameters(setup.sensor);
-  pcl::PointCloud<pcl::PointXYZL> labeled;
-  simulator.simulate(setup.scene, labeled);
-  auto xyz = pcl::make_shared<Cloud>();
-  pcl::copyPointCloud(labeled, *xyz);
-  return xyz;
-}
 
 struct Scenario {
   Cloud::Ptr coarse, fine, all;
@@ -53,8 +36,8 @@ scenario(std::size_t n)
   Scenario& s = cache[n];
   if (s.coarse)
     return s;
-  s.coarse = doorScan(n, 1);
-  const auto dense = doorScan(4 * n, 2);
+  s.coarse = selseg_bench::doorScan(n, 1);
+  const auto dense = selseg_bench::doorScan(4 * n, 2);
   const std::size_t wanted = n * 5 / 95;
   s.fine = pcl::make_shared<Cloud>();
   for (double half = 0.01; half < 1.0 && s.fine->size() < wanted; half *= 1.05) {
