@@ -64,6 +64,33 @@ standardNormal(std::mt19937& engine)
   return radius * std::cos(2.0 * kPi * uniform01(engine));
 }
 
+/** The jittered grid every scan samples: rows x columns cells from (theta_min,
+ * phi_min), each shifted by up to jitter / 2 of a cell in both angles and given an
+ * acceptance draw, all three from \a engine in that order; f(theta, phi, accept) per
+ * cell, row by row. */
+template <typename F>
+void
+forEachJitteredCell(double theta_min,
+                    double phi_min,
+                    double cell_width,
+                    double cell_height,
+                    long rows,
+                    long columns,
+                    double jitter,
+                    std::mt19937& engine,
+                    F f)
+{
+  for (long row = 0; row < rows; ++row)
+    for (long column = 0; column < columns; ++column) {
+      const double du = jitter * (uniform01(engine) - 0.5);
+      const double dv = jitter * (uniform01(engine) - 0.5);
+      const double accept = uniform01(engine);
+      f(theta_min + (column + 0.5 + du) * cell_width,
+        phi_min + (row + 0.5 + dv) * cell_height,
+        accept);
+    }
+}
+
 bool
 isFinite(const Eigen::Vector3d& v)
 {
@@ -676,16 +703,18 @@ SensorSimulator::sampleDirections(SimulationDetails& details) const
   std::mt19937 engine = makeEngine(params_.seed, kGridStream);
   std::vector<std::array<double, 2>> kept;
   kept.reserve(params_.num_rays + params_.num_rays / 4);
-  for (long row = 0; row < rows; ++row)
-    for (long column = 0; column < columns; ++column) {
-      const double du = params_.jitter * (uniform01(engine) - 0.5);
-      const double dv = params_.jitter * (uniform01(engine) - 0.5);
-      const double accept = uniform01(engine);
-      const double theta = params_.theta_min + (column + 0.5 + du) * cell_width;
-      const double phi = params_.phi_min + (row + 0.5 + dv) * cell_height;
-      if (accept < getRelativeDensity(theta, phi))
-        kept.push_back({theta, phi});
-    }
+  forEachJitteredCell(params_.theta_min,
+                      params_.phi_min,
+                      cell_width,
+                      cell_height,
+                      rows,
+                      columns,
+                      params_.jitter,
+                      engine,
+                      [&](double theta, double phi, double accept) {
+                        if (accept < getRelativeDensity(theta, phi))
+                          kept.push_back({theta, phi});
+                      });
   details.candidates = static_cast<std::size_t>(rows * columns);
   details.rays = kept.size();
   return kept;
@@ -818,25 +847,27 @@ SensorSimulator::simulateWindow(const Scene& scene,
   const long rows = std::max(1L, std::lround(height / window.step));
   const double cell_width = width / columns;
   const double cell_height = height / rows;
-  for (long row = 0; row < rows; ++row)
-    for (long column = 0; column < columns; ++column) {
-      const double du = params_.jitter * (uniform01(grid_engine) - 0.5);
-      const double dv = params_.jitter * (uniform01(grid_engine) - 0.5);
-      const double accept = uniform01(grid_engine);
-      const double theta = window.theta_min + (column + 0.5 + du) * cell_width;
-      const double phi = window.phi_min + (row + 0.5 + dv) * cell_height;
-      const bool dropped = uniform01(dropout_engine) < params_.dropout;
-      const double deviate = standardNormal(noise_engine);
-      if (!(accept < getRelativeDensity(theta, phi)))
-        continue;
-      ++d.rays;
-      if (isInHole(theta, phi))
-        ++d.in_holes;
-      else if (dropped)
-        ++d.dropped;
-      else
-        castOne(scene, {theta, phi}, deviate, cloud, d);
-    }
+  forEachJitteredCell(window.theta_min,
+                      window.phi_min,
+                      cell_width,
+                      cell_height,
+                      rows,
+                      columns,
+                      params_.jitter,
+                      grid_engine,
+                      [&](double theta, double phi, double accept) {
+                        const bool dropped = uniform01(dropout_engine) < params_.dropout;
+                        const double deviate = standardNormal(noise_engine);
+                        if (!(accept < getRelativeDensity(theta, phi)))
+                          return;
+                        ++d.rays;
+                        if (isInHole(theta, phi))
+                          ++d.in_holes;
+                        else if (dropped)
+                          ++d.dropped;
+                        else
+                          castOne(scene, {theta, phi}, deviate, cloud, d);
+                      });
   d.candidates = static_cast<std::size_t>(rows * columns);
   cloud.width = static_cast<std::uint32_t>(cloud.size());
   cloud.height = 1;
