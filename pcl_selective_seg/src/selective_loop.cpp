@@ -151,6 +151,24 @@ scoreSegmentation(const pcl::PointCloud<pcl::PointXYZL>& cloud,
   return true;
 }
 
+namespace {
+
+/** The score's acquisition figures after one scan of the whole view. */
+void
+startScore(const SensorParameters& view,
+           std::size_t points,
+           double seconds,
+           ScanScore& score)
+{
+  score.points = points;
+  score.windows = 1;
+  score.scanned_solid_angle =
+      windowSolidAngle(view.theta_min, view.theta_max, view.phi_min, view.phi_max);
+  score.seconds = seconds;
+}
+
+} // namespace
+
 bool
 runUniformScan(const SimulationSetup& setup,
                double step,
@@ -172,12 +190,7 @@ runUniformScan(const SimulationSetup& setup,
   std::vector<pcl::PointIndices> clusters;
   if (!seg.extract(clusters))
     return false;
-  score.points = cloud->size();
-  score.windows = 1;
-  const auto& s = setup.sensor;
-  score.scanned_solid_angle =
-      windowSolidAngle(s.theta_min, s.theta_max, s.phi_min, s.phi_max);
-  score.seconds = seg.getResult().timings.total;
+  startScore(setup.sensor, cloud->size(), seg.getResult().timings.total, score);
   if (out)
     *out = *cloud;
   return scoreSegmentation(*cloud, seg.getResult(), reference, 4.0 * step, score);
@@ -235,12 +248,7 @@ runSelectiveLoop(const SimulationSetup& setup,
     return fail("segmenting the coarse scan failed (reason above)");
 
   ScanScore score;
-  score.points = cloud->size();
-  score.windows = 1;
-  const auto& s = setup.sensor;
-  score.scanned_solid_angle =
-      windowSolidAngle(s.theta_min, s.theta_max, s.phi_min, s.phi_max);
-  score.seconds = seg.getResult().timings.total;
+  startScore(setup.sensor, cloud->size(), seg.getResult().timings.total, score);
   std::vector<RegionOfInterest> regions;
   RegionOfInterestStats stats;
   for (int round = 0;; ++round) {
