@@ -47,15 +47,24 @@ const char*
 typeName(std::uint8_t datatype)
 {
   switch (datatype) {
-  case pcl::PCLPointField::INT8: return "int8";
-  case pcl::PCLPointField::UINT8: return "uint8";
-  case pcl::PCLPointField::INT16: return "int16";
-  case pcl::PCLPointField::UINT16: return "uint16";
-  case pcl::PCLPointField::INT32: return "int32";
-  case pcl::PCLPointField::UINT32: return "uint32";
-  case pcl::PCLPointField::FLOAT32: return "float32";
-  case pcl::PCLPointField::FLOAT64: return "float64";
-  default: return "unknown";
+  case pcl::PCLPointField::INT8:
+    return "int8";
+  case pcl::PCLPointField::UINT8:
+    return "uint8";
+  case pcl::PCLPointField::INT16:
+    return "int16";
+  case pcl::PCLPointField::UINT16:
+    return "uint16";
+  case pcl::PCLPointField::INT32:
+    return "int32";
+  case pcl::PCLPointField::UINT32:
+    return "uint32";
+  case pcl::PCLPointField::FLOAT32:
+    return "float32";
+  case pcl::PCLPointField::FLOAT64:
+    return "float64";
+  default:
+    return "unknown";
   }
 }
 
@@ -114,6 +123,31 @@ plausibleSize(const std::string& path,
   return false;
 }
 
+/** The header keyword PCL 1.13's PCDReader::readHeader takes a line for. It matches
+ * keywords by prefix ("COUNTS" is a COUNT line) and goes on reading lines after DATA
+ * until one it does not know; our check must see the lines it sees, the same way. */
+std::string
+pclHeaderKeyword(const std::string& word)
+{
+  static const char* const keywords[] = {"VERSION",
+                                         "FIELDS",
+                                         "COLUMNS",
+                                         "SIZE",
+                                         "TYPE",
+                                         "COUNT",
+                                         "WIDTH",
+                                         "HEIGHT",
+                                         "VIEWPOINT",
+                                         "POINTS",
+                                         "DATA"};
+  if (!word.empty() && word[0] == '#')
+    return "#";
+  for (const char* k : keywords)
+    if (word.compare(0, std::strlen(k), k) == 0)
+      return std::strcmp(k, "COLUMNS") == 0 ? "FIELDS" : k;
+  return "";
+}
+
 /** The sizes a PCD header claims, read without PCL: PCL 1.13's readHeader already
  * allocates the data block the header claims, however large. */
 bool
@@ -127,15 +161,40 @@ pcdSizesPlausible(const std::string& path, std::string& error)
   std::vector<unsigned long long> sizes, counts;
   std::string data;
   bool data_seen = false;
+  std::streamoff data_start = 0;
   std::set<std::string> seen;
   const auto corrupt = [&](const std::string& why) {
     error = "cannot read '" + path + "' as PCD: " + why + ": the header is corrupt";
     return false;
   };
-  while (!data_seen && std::getline(in, line)) {
+  while (std::getline(in, line)) {
+    if (line.empty())
+      continue;
     std::istringstream words(line);
     std::string key, word;
     words >> key;
+    key = pclHeaderKeyword(key);
+    if (data_seen) {
+      // PCL reads on after DATA, skipping comments, until a line it does not know: the
+      // data must not start with what it would take for a header line.
+      if (key == "#")
+        continue;
+      if (!key.empty())
+        return corrupt("a header line follows DATA");
+      break;
+    }
+    // PCL splits a line into values at spaces, tabs and carriage returns, but reads the
+    // numbers with >>, which also stops at other white space: a header line with
+    // control characters would be counted one way and read another.
+    if (std::any_of(line.begin(), line.end(), [](char c) {
+          const auto u = static_cast<unsigned char>(c);
+          return (u < 0x20 && c != '\t' && c != '\r') || u == 0x7f;
+        }))
+      return corrupt("a header line holds control characters");
+    if (key == "#")
+      continue;
+    if (key.empty())
+      return corrupt("'" + line.substr(0, 40) + "' is no PCD header line");
     std::vector<std::string> rest;
     while (words >> word)
       rest.push_back(word);
@@ -149,8 +208,15 @@ pcdSizesPlausible(const std::string& path, std::string& error)
       return true;
     };
     std::vector<unsigned long long> one;
-    static const std::vector<std::string> keys = {
-        "VERSION", "FIELDS", "SIZE", "TYPE", "COUNT", "WIDTH", "HEIGHT", "POINTS"};
+    static const std::vector<std::string> keys = {"VERSION",
+                                                  "FIELDS",
+                                                  "SIZE",
+                                                  "TYPE",
+                                                  "COUNT",
+                                                  "WIDTH",
+                                                  "HEIGHT",
+                                                  "VIEWPOINT",
+                                                  "POINTS"};
     if (std::find(keys.begin(), keys.end(), key) != keys.end() &&
         !seen.insert(key).second)
       return corrupt("it has two " + key + " lines");
@@ -164,10 +230,10 @@ pcdSizesPlausible(const std::string& path, std::string& error)
       if (!numbers(one) || one.size() != 1)
         return corrupt("its " + key + " line is not one number");
       (key == "WIDTH" ? width : key == "HEIGHT" ? height : points) = one[0];
-    }
-    else if (key == "DATA") {
+    } else if (key == "DATA") {
       data = rest.empty() ? "" : rest[0];
       data_seen = true;
+      data_start = in.tellg();
     }
   }
   if (!data_seen || fields.empty()) {
@@ -189,10 +255,23 @@ pcdSizesPlausible(const std::string& path, std::string& error)
     bytes_per_point += sizes[i] * count;
     values_per_point += count;
   }
-  if (width > (1ull << 40) || height > (1ull << 40) || points > (1ull << 40))
+  // PCL holds WIDTH and HEIGHT in 32 bits and sums a point's bytes in an int.
+  if (width > 0xffffffffull || height > 0xffffffffull || points > (1ull << 40))
     return corrupt("it claims an implausible number of points");
+  if (bytes_per_point > 0x7fffffffull)
+    return corrupt("its points claim " + std::to_string(bytes_per_point) +
+                   " bytes each");
   points = std::max(points, width * height);
-  const long long data_bytes = bytesAfter(path, in.tellg());
+  if (points > (1ull << 40))
+    return corrupt("it claims an implausible number of points");
+  const long long data_bytes =
+      bytesAfter(path, static_cast<unsigned long long>(data_start));
+  in.clear();
+  in.seekg(data_start);
+  // Up to 2^40 points of up to 2^31 bytes: saturate rather than wrap.
+  const auto claimed = [&](unsigned long long per_point) {
+    return per_point != 0 && points > ~0ull / per_point ? ~0ull : points * per_point;
+  };
   if (data == "binary_compressed") { // two sizes, then the compressed data
     std::uint32_t stored[2] = {0, 0};
     if (!in.read(reinterpret_cast<char*>(stored), sizeof stored)) {
@@ -203,17 +282,17 @@ pcdSizesPlausible(const std::string& path, std::string& error)
     if (!plausibleSize(path, stored[0] + 8ull, data_bytes, error) ||
         !plausibleSize(path, stored[1] / 100ull, data_bytes, error))
       return false;
-    if (stored[1] != points * bytes_per_point) {
+    if (stored[1] != claimed(bytes_per_point)) {
       error = "cannot read '" + path + "': its compressed data holds " +
               std::to_string(stored[1]) + " bytes where the header promises " +
-              std::to_string(points * bytes_per_point) + ": the file is corrupt";
+              std::to_string(claimed(bytes_per_point)) + ": the file is corrupt";
       return false;
     }
     return true;
   }
   // Binary data is exactly the points' bytes; text takes at least a byte per value.
   return plausibleSize(path,
-                       points * (data == "binary" ? bytes_per_point : values_per_point),
+                       claimed(data == "binary" ? bytes_per_point : values_per_point),
                        data_bytes,
                        error);
 }
@@ -269,14 +348,12 @@ plyHeaderUsable(const std::string& path, std::string& error)
       ok = static_cast<bool>(words >> format >> version) &&
            (format == "ascii" || format == "binary_little_endian" ||
             format == "binary_big_endian");
-    }
-    else if (keyword == "element") {
+    } else if (keyword == "element") {
       std::string name, rest;
       ok = static_cast<bool>(words >> name >> count) && !(words >> rest) &&
            count >= 0 && count <= (1ll << 40);
       in_element = true;
-    }
-    else if (keyword == "property" && in_element) {
+    } else if (keyword == "property" && in_element) {
       std::string type, name;
       ok = static_cast<bool>(words >> type >> name);
       values += static_cast<unsigned long long>(count);
@@ -302,11 +379,15 @@ extractXYZ(const std::string& path,
   const std::size_t points = static_cast<std::size_t>(blob.width) * blob.height;
   const pcl::PCLPointField* fields[3];
   for (int k = 0; k < 3; ++k) {
-    fields[k] = &blob.fields[pcl::getFieldIndex(blob, k == 0 ? "x" : k == 1 ? "y" : "z")];
+    fields[k] = &blob.fields[pcl::getFieldIndex(blob,
+                                                k == 0   ? "x"
+                                                : k == 1 ? "y"
+                                                         : "z")];
     const std::size_t size = fields[k]->datatype == pcl::PCLPointField::FLOAT64 ? 8 : 4;
     if (fields[k]->offset + size > blob.point_step ||
         (points > 0 && blob.data.size() < points * blob.point_step)) {
-      error = "cannot read '" + path + "': its fields do not fit in its points (corrupt)";
+      error =
+          "cannot read '" + path + "': its fields do not fit in its points (corrupt)";
       return false;
     }
   }
@@ -316,13 +397,13 @@ extractXYZ(const std::string& path,
   cloud.is_dense = false;
   for (std::size_t i = 0; i < points; ++i)
     for (int k = 0; k < 3; ++k) {
-      const std::uint8_t* at = blob.data.data() + i * blob.point_step + fields[k]->offset;
+      const std::uint8_t* at =
+          blob.data.data() + i * blob.point_step + fields[k]->offset;
       if (fields[k]->datatype == pcl::PCLPointField::FLOAT64) {
         double v;
         std::memcpy(&v, at, sizeof v);
         cloud[i].data[k] = static_cast<float>(v);
-      }
-      else
+      } else
         std::memcpy(&cloud[i].data[k], at, sizeof(float));
     }
   return true;
@@ -342,8 +423,9 @@ loadBinaryFormat(const std::string& path,
     return false;
   int rc = -1;
   try {
-    rc = ext == ".pcd" ? pcl::PCDReader().read(path, blob, origin, orientation, version)
-                       : pcl::PLYReader().read(path, blob, origin, orientation, version);
+    rc = ext == ".pcd"
+             ? pcl::PCDReader().read(path, blob, origin, orientation, version)
+             : pcl::PLYReader().read(path, blob, origin, orientation, version);
   } catch (const std::exception& e) { // PCL's readers throw on some corrupt files
     rc = -1;
   }

@@ -20,6 +20,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -106,28 +107,23 @@ pcdHeader(const std::string& fields,
 
 class ToolFailure : public ::testing::Test {
 protected:
-  void
-  SetUp() override
+  void SetUp() override
   {
     if (tool.empty() || !fs::exists(tool) || !fs::exists(scan))
       GTEST_SKIP() << "tool or scan missing";
     // The process id: several builds may run this suite at once on one machine.
-    dir = fs::temp_directory_path() /
-          ("selseg_failure_" +
-           std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) +
-           "_" + std::to_string(::getpid()));
+    dir =
+        fs::temp_directory_path() /
+        ("selseg_failure_" +
+         std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) +
+         "_" + std::to_string(::getpid()));
     fs::remove_all(dir);
     fs::create_directories(dir / "in");
     fs::create_directories(dir / "out");
   }
-  void
-  TearDown() override
-  {
-    fs::remove_all(dir);
-  }
+  void TearDown() override { fs::remove_all(dir); }
   /** Files in out/ (outputs, temporaries, leftovers). */
-  std::vector<std::string>
-  outputs() const
+  std::vector<std::string> outputs() const
   {
     std::vector<std::string> names;
     for (const auto& e : fs::directory_iterator(dir / "out"))
@@ -135,17 +131,16 @@ protected:
     return names;
   }
   /** Every output option, into out/. */
-  std::string
-  allOutputs() const
+  std::string allOutputs() const
   {
     const fs::path o = dir / "out";
-    return " -o " + shellQuoted(o / "labels.pcd") + " -mesh_ply " + shellQuoted(o / "mesh.ply") +
-           " -mesh_vtk " + shellQuoted(o / "mesh.vtk") + " -leaves " +
-           shellQuoted(o / "leaves.pcd") + " -json " + shellQuoted(o / "summary.json");
+    return " -o " + shellQuoted(o / "labels.pcd") + " -mesh_ply " +
+           shellQuoted(o / "mesh.ply") + " -mesh_vtk " + shellQuoted(o / "mesh.vtk") +
+           " -leaves " + shellQuoted(o / "leaves.pcd") + " -json " +
+           shellQuoted(o / "summary.json");
   }
   /** The tool must fail on \a input with exit code 1, say \a why, write nothing. */
-  void
-  expectRejected(const fs::path& input, const std::string& why)
+  void expectRejected(const fs::path& input, const std::string& why)
   {
     const Outcome o = run(shellQuoted(input) + " -ignore_viewpoint" + allOutputs());
     EXPECT_EQ(o.code, 1) << input << ": " << o.messages;
@@ -168,12 +163,17 @@ TEST_F(ToolFailure, TruncatedFilesAreRejected)
   pcl::io::savePLYFileBinary((in / "binary.ply").string(), cloud);
   pcl::io::savePLYFileASCII((in / "ascii.ply").string(), cloud);
   fs::copy_file(scan, in / "scan.pcd");
-  for (const char* name :
-       {"binary.pcd", "compressed.pcd", "ascii.pcd", "binary.ply", "ascii.ply", "scan.pcd"}) {
+  for (const char* name : {"binary.pcd",
+                           "compressed.pcd",
+                           "ascii.pcd",
+                           "binary.ply",
+                           "ascii.ply",
+                           "scan.pcd"}) {
     const std::string full = readFile(in / name);
     // Cut in the data (two thirds) and in the header (40 bytes).
     for (const std::size_t keep : {full.size() * 2 / 3, std::size_t(40)}) {
-      writeFile(in / ("cut_" + std::to_string(keep) + "_" + name), full.substr(0, keep));
+      writeFile(in / ("cut_" + std::to_string(keep) + "_" + name),
+                full.substr(0, keep));
       expectRejected(in / ("cut_" + std::to_string(keep) + "_" + name), "cannot read");
     }
   }
@@ -190,9 +190,10 @@ TEST_F(ToolFailure, CorruptFilesAreRejected)
   writeFile(in / "huge.pcd",
             pcdHeader("x y z", "4 4 4", "F F F", "1 1 1", 4000000000u, "binary"));
   expectRejected(in / "huge.pcd", "cannot read");
-  writeFile(in / "huge_compressed.pcd",
-            pcdHeader("x y z", "4 4 4", "F F F", "1 1 1", 4000000000u, "binary_compressed") +
-                std::string("\x10\0\0\0\xff\xff\xff\x7f", 8) + std::string(16, 'A'));
+  writeFile(
+      in / "huge_compressed.pcd",
+      pcdHeader("x y z", "4 4 4", "F F F", "1 1 1", 4000000000u, "binary_compressed") +
+          std::string("\x10\0\0\0\xff\xff\xff\x7f", 8) + std::string(16, 'A'));
   expectRejected(in / "huge_compressed.pcd", "cannot read");
   // Compressed data whose sizes disagree with the header.
   writeFile(in / "bad_compressed.pcd",
@@ -234,7 +235,8 @@ TEST_F(ToolFailure, FieldTypesAreCheckedOrConverted)
     doubles << p.x << " " << p.y << " " << p.z << "\n";
   writeFile(in / "doubles.pcd", doubles.str());
   const fs::path labels = dir / "out" / "labels.pcd";
-  const Outcome o = run(shellQuoted(in / "doubles.pcd") + " -ignore_viewpoint -o " + shellQuoted(labels));
+  const Outcome o = run(shellQuoted(in / "doubles.pcd") + " -ignore_viewpoint -o " +
+                        shellQuoted(labels));
   ASSERT_EQ(o.code, 0) << o.messages;
   pcl::PointCloud<pcl::PointXYZL> labeled;
   ASSERT_EQ(pcl::io::loadPCDFile(labels.string(), labeled), 0);
@@ -272,13 +274,13 @@ TEST_F(ToolFailure, UnwritableLocationsLeaveNothing)
   writeFile(dir / "out" / "a_file", "not a folder");
   const std::string in = shellQuoted(scan) + " -ignore_viewpoint";
   const std::vector<std::string> targets = {
-      (dir / "out" / "a_file" / "labels.pcd").string(), // under a file: ENOTDIR
+      (dir / "out" / "a_file" / "labels.pcd").string(),  // under a file: ENOTDIR
       (dir / "out" / "missing" / "labels.pcd").string(), // no such folder
-      "/proc/selseg_labels.pcd",                          // a read-only file system
+      "/proc/selseg_labels.pcd",                         // a read-only file system
   };
   for (const auto& target : targets) {
-    const Outcome o =
-        run(in + " -json " + shellQuoted(dir / "out" / "summary.json") + " -o '" + target + "'");
+    const Outcome o = run(in + " -json " + shellQuoted(dir / "out" / "summary.json") +
+                          " -o '" + target + "'");
     EXPECT_EQ(o.code, 1) << target << ": " << o.messages;
     EXPECT_NE(o.messages.find("Cannot write"), std::string::npos) << o.messages;
     EXPECT_EQ(outputs(), std::vector<std::string>{"a_file"}) << target;
@@ -286,8 +288,8 @@ TEST_F(ToolFailure, UnwritableLocationsLeaveNothing)
   // An output that is an existing folder: refused before anything is replaced.
   fs::create_directories(dir / "out" / "folder.pcd");
   writeFile(dir / "out" / "summary.json", "old");
-  const Outcome o = run(in + " -json " + shellQuoted(dir / "out" / "summary.json") + " -o " +
-                        shellQuoted(dir / "out" / "folder.pcd"));
+  const Outcome o = run(in + " -json " + shellQuoted(dir / "out" / "summary.json") +
+                        " -o " + shellQuoted(dir / "out" / "folder.pcd"));
   EXPECT_EQ(o.code, 1) << o.messages;
   EXPECT_EQ(readFile(dir / "out" / "summary.json"), "old");
   EXPECT_TRUE(fs::is_directory(dir / "out" / "folder.pcd"));
@@ -303,7 +305,8 @@ TEST_F(ToolFailure, FullDiskLeavesNothing)
   // (Not 0 KiB: LLVM's OpenMP runtime, in clang builds, then cannot create its
   // registration file in /dev/shm and aborts at start-up, before the tool runs.)
   for (const long limit : {4L, 16L, 600L, 2000L}) {
-    const Outcome o = run(shellQuoted(scan) + " -ignore_viewpoint" + allOutputs(), limit);
+    const Outcome o =
+        run(shellQuoted(scan) + " -ignore_viewpoint" + allOutputs(), limit);
     EXPECT_EQ(o.code, 1) << limit << " KiB: " << o.messages;
     EXPECT_NE(o.messages.find("free space"), std::string::npos) << o.messages;
     EXPECT_EQ(outputs(), std::vector<std::string>{"labels.pcd"}) << limit << " KiB";
@@ -321,13 +324,14 @@ TEST_F(ToolFailure, FullDiskLeavesNothing)
 TEST_F(ToolFailure, OutputsThatCollideAreUsageErrors)
 {
   const fs::path labels = dir / "out" / "x.pcd";
-  Outcome o = run(shellQuoted(scan) + " -ignore_viewpoint -o " + shellQuoted(labels) + " -leaves " +
-                  shellQuoted(labels));
+  Outcome o = run(shellQuoted(scan) + " -ignore_viewpoint -o " + shellQuoted(labels) +
+                  " -leaves " + shellQuoted(labels));
   EXPECT_EQ(o.code, 2) << o.messages;
   EXPECT_NE(o.messages.find("same file"), std::string::npos) << o.messages;
   const fs::path copy = dir / "in" / "scan.pcd";
   fs::copy_file(scan, copy);
-  o = run(shellQuoted(copy) + " -ignore_viewpoint -o " + shellQuoted(dir / "in" / "." / "scan.pcd"));
+  o = run(shellQuoted(copy) + " -ignore_viewpoint -o " +
+          shellQuoted(dir / "in" / "." / "scan.pcd"));
   EXPECT_EQ(o.code, 2) << o.messages;
   EXPECT_NE(o.messages.find("input"), std::string::npos) << o.messages;
   EXPECT_EQ(readFile(copy), readFile(scan));
@@ -342,6 +346,52 @@ TEST_F(ToolFailure, LyingHeadersUseBoundedMemory)
                 "0 0 1\n");
   const Outcome o = run(shellQuoted(dir / "in" / "huge.pcd") + " -ignore_viewpoint");
   EXPECT_EQ(o.code, 1) << o.messages;
+  rusage usage{};
+  getrusage(RUSAGE_CHILDREN, &usage);
+  EXPECT_LT(usage.ru_maxrss, 1L << 20) << "KiB"; // below 1 GiB
+}
+
+// PCL's PCD header reader takes keywords by prefix and reads on after DATA. Each file
+// below makes it allocate 80 points of 26,843,552 bytes (2.1 GB, zero-filled) before it
+// sees that the data is missing: the tool must refuse the header before PCL reads it,
+// with its own message, not run out of memory.
+TEST_F(ToolFailure, HeadersPclReadsDifferentlyAreRefused)
+{
+  const std::string start = "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\n";
+  const std::string organized = "WIDTH 10\nHEIGHT 8\nPOINTS 80\n";
+  const std::string data(960, '\0'); // 80 points of x, y, z
+  const struct {
+    const char* name;
+    std::string content;
+    const char* message;
+  } cases[] = {
+      // A COUNT line hidden in the binary data: PCL reads it, and POINTS after it.
+      {"after_data.pcd",
+       start + "COUNT 1 1 1\n" + organized +
+           "DATA binary\nCOUNT 1 1 6710886\nPOINTS 80\n" + data,
+       "follows DATA"},
+      // "COUNTS" is a COUNT line to PCL.
+      {"prefix.pcd",
+       start + "COUNTS 1 1 6710886\n" + organized + "DATA binary\n" + data,
+       "COUNT 6710886"},
+      // A form feed splits values for >> but not for PCL's count of them.
+      {"form_feed.pcd",
+       start + "COUNT 1 1\f6710886 1\n" + organized + "DATA binary\n" + data,
+       "control characters"},
+      // A line PCL does not know ends its header: DATA would never be seen.
+      {"unknown_line.pcd",
+       start + "COUNT 1 1 1\nRANGE 0 1\n" + organized + "DATA binary\n" + data,
+       "no PCD header line"},
+  };
+  for (const auto& c : cases) {
+    writeFile(dir / "in" / c.name, c.content);
+    const Outcome o = run(shellQuoted(dir / "in" / c.name) + " -ignore_viewpoint");
+    EXPECT_EQ(o.code, 1) << c.name << ": " << o.messages;
+    EXPECT_NE(o.messages.find("header is corrupt"), std::string::npos)
+        << c.name << ": " << o.messages;
+    EXPECT_NE(o.messages.find(c.message), std::string::npos)
+        << c.name << ": " << o.messages;
+  }
   rusage usage{};
   getrusage(RUSAGE_CHILDREN, &usage);
   EXPECT_LT(usage.ru_maxrss, 1L << 20) << "KiB"; // below 1 GiB
