@@ -444,6 +444,52 @@ TEST(OctreePointCloudNormalVariance, RecomputeWithAnotherThreshold)
   }
 }
 
+// The normals as plain 3-vectors (the form SelectiveSegmentation lends without a copy)
+// give the same tree as a pcl::Normal cloud, invalid points and leaf areas included.
+TEST(OctreePointCloudNormalVariance, NormalVectorsGiveTheSameTree)
+{
+  Scene scene = ridge();
+  (*scene.normals)[3].normal_y = std::numeric_limits<float>::quiet_NaN();
+  (*scene.areas)[7] = 0.0;
+  const auto from_cloud = buildOctree(scene, 0.05, kPaperThreshold);
+  auto vectors = std::make_shared<Octree::NormalVectors>();
+  for (const auto& n : *scene.normals)
+    vectors->push_back(n.getNormalVector3fMap());
+  Octree from_vectors(0.05);
+  from_vectors.setInputCloud(scene.cloud);
+  from_vectors.setInputNormals(vectors, scene.areas);
+  ASSERT_TRUE(from_vectors.addPointsFromInputCloud());
+  from_vectors.computeAdaptiveLeaves(kPaperThreshold, kMinPoints);
+  expectPartition(from_vectors, validPoints(scene));
+  ASSERT_GT(from_cloud->getAdaptiveLeaves().size(), 1u);
+  ASSERT_EQ(from_vectors.getAdaptiveLeaves().size(),
+            from_cloud->getAdaptiveLeaves().size());
+  EXPECT_EQ(from_vectors.getOrderedIndices(), from_cloud->getOrderedIndices());
+  double total_area = 0.0;
+  for (std::size_t l = 0; l < from_cloud->getAdaptiveLeaves().size(); ++l) {
+    const AdaptiveLeaf& a = from_vectors.getAdaptiveLeaves()[l];
+    const AdaptiveLeaf& b = from_cloud->getAdaptiveLeaves()[l];
+    EXPECT_EQ(a.key, b.key);
+    EXPECT_EQ(a.begin, b.begin);
+    EXPECT_EQ(a.end, b.end);
+    EXPECT_EQ(a.area, b.area);
+    EXPECT_EQ(a.sigma_theta, b.sigma_theta);
+    EXPECT_EQ(a.sigma_phi, b.sigma_phi);
+    EXPECT_EQ(a.normal, b.normal);
+    total_area += a.area;
+  }
+  // eq. 6: the leaves' areas add up to the areas of the valid points.
+  double expected_area = 0.0;
+  for (const auto i : validPoints(scene))
+    expected_area += (*scene.areas)[i];
+  EXPECT_NEAR(total_area, expected_area, 1e-12 * expected_area);
+  // Without normals of either kind, nothing is inserted.
+  Octree none(0.05);
+  none.setInputCloud(scene.cloud);
+  none.setInputNormals(Octree::NormalVectorsConstPtr(), scene.areas);
+  EXPECT_FALSE(none.addPointsFromInputCloud());
+}
+
 TEST(OctreePointCloudNormalVariance, NoValidPoint)
 {
   Scene scene;

@@ -65,6 +65,8 @@ public:
   using NormalCloud = pcl::PointCloud<pcl::Normal>;
   using NormalCloudConstPtr = typename NormalCloud::ConstPtr;
   using AreasConstPtr = std::shared_ptr<const std::vector<double>>;
+  using NormalVectors = std::vector<Eigen::Vector3f>;
+  using NormalVectorsConstPtr = std::shared_ptr<const NormalVectors>;
 
   /** \param[in] resolution finest voxel edge [m], > 0 */
   explicit OctreePointCloudNormalVariance(double resolution);
@@ -73,6 +75,11 @@ public:
    * cloud. Points whose normal is not finite or whose area is not positive are skipped
    * by addPointsFromInputCloud(). */
   void setInputNormals(const NormalCloudConstPtr& normals, const AreasConstPtr& areas);
+
+  /** \brief The same with the normals as plain 3-vectors (12 bytes per point instead of
+   * pcl::Normal's 32): no copy is needed when they are kept that way. */
+  void setInputNormals(const NormalVectorsConstPtr& normals,
+                       const AreasConstPtr& areas);
 
   /** \brief Threads for the per-point work (0: all cores); the result does not
    * depend on it. */
@@ -117,7 +124,6 @@ protected:
   struct NodeStatistics {
     Eigen::Vector3d sum_weighted_normal = Eigen::Vector3d::Zero();
     double sum_weight = 0.0;
-    double sum_area = 0.0;
     double sigma_theta = 0.0;
     double sigma_phi = 0.0;
     bool complete = true; ///< false: sigmas of a prefix only (computeStatistics())
@@ -160,14 +166,25 @@ protected:
   AdaptiveLeaf makeLeaf(const PendingNode& node, const NodeStatistics& s) const;
 
 private:
+  /** The input normal of point \a i, from whichever form was given. */
+  Eigen::Vector3f inputNormal(std::size_t i) const
+  {
+    return normals_ ? Eigen::Vector3f((*normals_)[i].getNormalVector3fMap())
+                    : (*normal_vectors_)[i];
+  }
+  std::size_t numInputNormals() const
+  {
+    return normals_ ? normals_->size() : normal_vectors_ ? normal_vectors_->size() : 0;
+  }
+
   NormalCloudConstPtr normals_;
+  NormalVectorsConstPtr normal_vectors_;
   AreasConstPtr areas_;
   Eigen::Quaternionf sensor_orientation_ = Eigen::Quaternionf::Identity();
   pcl::Indices ordered_indices_;
   std::vector<Eigen::Vector3d> ordered_normals_; ///< sensor frame, reversed (eq. 5)
   std::vector<double> ordered_theta_;            ///< angles of ordered_normals_ [rad]
   std::vector<double> ordered_phi_;
-  std::vector<double> ordered_areas_;   ///< A_p
   std::vector<double> ordered_weights_; ///< 1 / A_p (eq. 4)
   std::vector<AdaptiveLeaf> leaves_;
   unsigned int num_threads_ = std::max(1u, std::thread::hardware_concurrency());

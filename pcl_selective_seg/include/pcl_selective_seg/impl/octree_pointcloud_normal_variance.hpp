@@ -65,6 +65,17 @@ OctreePointCloudNormalVariance<PointT>::setInputNormals(
     const NormalCloudConstPtr& normals, const AreasConstPtr& areas)
 {
   normals_ = normals;
+  normal_vectors_.reset();
+  areas_ = areas;
+}
+
+template <typename PointT>
+void
+OctreePointCloudNormalVariance<PointT>::setInputNormals(
+    const NormalVectorsConstPtr& normals, const AreasConstPtr& areas)
+{
+  normals_.reset();
+  normal_vectors_ = normals;
   areas_ = areas;
 }
 
@@ -73,10 +84,10 @@ bool
 OctreePointCloudNormalVariance<PointT>::isValidPoint(pcl::index_t index) const
 {
   const auto i = static_cast<std::size_t>(index);
-  if (i >= this->input_->size() || i >= normals_->size() || i >= areas_->size())
+  if (i >= this->input_->size() || i >= numInputNormals() || i >= areas_->size())
     return false;
   const double area = (*areas_)[i];
-  return pcl::isFinite((*this->input_)[i]) && pcl::isNormalFinite((*normals_)[i]) &&
+  return pcl::isFinite((*this->input_)[i]) && inputNormal(i).allFinite() &&
          std::isfinite(area) && area > 0.0;
 }
 
@@ -84,7 +95,7 @@ template <typename PointT>
 bool
 OctreePointCloudNormalVariance<PointT>::addPointsFromInputCloud()
 {
-  if (!this->input_ || !normals_ || !areas_)
+  if (!this->input_ || (!normals_ && !normal_vectors_) || !areas_)
     return false;
   pcl::Indices valid;
   const auto consider = [&](pcl::index_t i) {
@@ -204,7 +215,6 @@ OctreePointCloudNormalVariance<PointT>::computeNormalAngles()
   ordered_normals_.resize(n);
   ordered_theta_.resize(n);
   ordered_phi_.resize(n);
-  ordered_areas_.resize(n);
   ordered_weights_.resize(n);
   const Eigen::Matrix3d to_sensor =
       sensor_orientation_.toRotationMatrix().transpose().template cast<double>();
@@ -214,13 +224,12 @@ OctreePointCloudNormalVariance<PointT>::computeNormalAngles()
   for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(n); ++k) {
     const auto i = ordered_indices_[k];
     const Eigen::Vector3d m =
-        -(to_sensor * (*normals_)[i].getNormalVector3fMap().template cast<double>())
+        -(to_sensor * inputNormal(static_cast<std::size_t>(i)).template cast<double>())
              .normalized();
     ordered_normals_[k] = m;
     ordered_theta_[k] = std::atan2(m.x(), m.z());
     ordered_phi_[k] = std::atan2(m.y(), m.z());
-    ordered_areas_[k] = (*areas_)[i];
-    ordered_weights_[k] = 1.0 / ordered_areas_[k]; // eq. 4: weight 1 / A_p
+    ordered_weights_[k] = 1.0 / (*areas_)[i]; // eq. 4: weight 1 / A_p
   }
 }
 
@@ -262,7 +271,6 @@ OctreePointCloudNormalVariance<PointT>::computeStatistics(std::size_t begin,
     const double w = ordered_weights_[k];
     s.sum_weighted_normal += w * ordered_normals_[k];
     s.sum_weight += w;
-    s.sum_area += ordered_areas_[k]; // eq. 6
   }
   const Eigen::Vector3d mean = s.sum_weighted_normal.normalized();
   const double theta_v = std::atan2(mean.x(), mean.z());
@@ -302,7 +310,11 @@ OctreePointCloudNormalVariance<PointT>::makeLeaf(const PendingNode& node,
       sensor_orientation_.toRotationMatrix().template cast<double>();
   leaf.normal =
       (-(to_cloud * s.sum_weighted_normal)).normalized().template cast<float>();
-  leaf.area = s.sum_area;
+  // eq. 6: the leaf's area, summed in the leaf's point order (only leaves need it).
+  double area = 0.0;
+  for (std::size_t k = node.begin; k < node.end; ++k)
+    area += (*areas_)[static_cast<std::size_t>(ordered_indices_[k])];
+  leaf.area = area;
   leaf.sigma_theta = static_cast<float>(s.sigma_theta);
   leaf.sigma_phi = static_cast<float>(s.sigma_phi);
   return leaf;
@@ -323,10 +335,9 @@ OctreePointCloudNormalVariance<PointT>::computeAdaptiveLeaves(
   orderPoints(this->root_node_);
   computeNormalAngles();
   const std::size_t min_points = std::max<std::size_t>(min_points_to_split, 2);
-  const bool finite_weights =
-      std::all_of(ordered_weights_.begin(), ordered_weights_.end(), [](double w) {
-        return std::isfinite(w);
-      });
+  const bool finite_weights = std::all_of(ordered_weights_.begin(),
+                                          ordered_weights_.end(),
+                                          [](double w) { return std::isfinite(w); });
   const double kNever = std::numeric_limits<double>::infinity();
   // Level by level from the root: the statistics of a level's nodes in parallel (each
   // node one sequential pass, so the same sums for any thread count), then the
@@ -335,6 +346,7 @@ OctreePointCloudNormalVariance<PointT>::computeAdaptiveLeaves(
   std::vector<PendingNode> level(1), next;
   level[0].node = this->root_node_;
   std::vector<NodeStatistics> stats;
+  std::vector<std::uint8_t> split;
   while (!level.empty()) {
     stats.resize(level.size());
 #ifdef _OPENMP
@@ -353,14 +365,22 @@ OctreePointCloudNormalVariance<PointT>::computeAdaptiveLeaves(
     }
     next.clear();
     const std::size_t first_new_leaf = leaves_.size();
+    split.resize(level.size());
+    std::size_t num_new_leaves = 0;
     for (std::size_t i = 0; i < level.size(); ++i) {
-      const PendingNode& node = level[i];
       const NodeStatistics& s = stats[i];
       const bool varies = s.sigma_theta > max_std_dev || s.sigma_phi > max_std_dev;
-      const bool can_split = node.node->getNodeType() == pcl::octree::BRANCH_NODE &&
-                             node.end - node.begin >= min_points;
-      if (!(varies && can_split)) {
-        leaves_.push_back(makeLeaf(node, s));
+      split[i] = varies && level[i].node->getNodeType() == pcl::octree::BRANCH_NODE &&
+                 level[i].end - level[i].begin >= min_points;
+      num_new_leaves += split[i] ? 0 : 1;
+    }
+    // Grown by exactly this level's leaves: doubling would hold three times the leaves
+    // at the pipeline's peak of memory.
+    leaves_.reserve(first_new_leaf + num_new_leaves);
+    for (std::size_t i = 0; i < level.size(); ++i) {
+      const PendingNode& node = level[i];
+      if (!split[i]) {
+        leaves_.push_back(makeLeaf(node, stats[i]));
         continue;
       }
       const auto* branch = static_cast<const BranchNode*>(node.node);
@@ -377,12 +397,11 @@ OctreePointCloudNormalVariance<PointT>::computeAdaptiveLeaves(
     }
     // Depth-first order: the leaves' point ranges are disjoint and ordered so; each
     // level's leaves come in that order.
-    std::inplace_merge(leaves_.begin(),
-                       leaves_.begin() + static_cast<std::ptrdiff_t>(first_new_leaf),
-                       leaves_.end(),
-                       [](const AdaptiveLeaf& a, const AdaptiveLeaf& b) {
-                         return a.begin < b.begin;
-                       });
+    std::inplace_merge(
+        leaves_.begin(),
+        leaves_.begin() + static_cast<std::ptrdiff_t>(first_new_leaf),
+        leaves_.end(),
+        [](const AdaptiveLeaf& a, const AdaptiveLeaf& b) { return a.begin < b.begin; });
     level.swap(next);
   }
   // The per-point scratch is not needed any more (the leaves hold their statistics).
@@ -396,7 +415,6 @@ OctreePointCloudNormalVariance<PointT>::releaseScratch()
   std::vector<Eigen::Vector3d>().swap(ordered_normals_);
   std::vector<double>().swap(ordered_theta_);
   std::vector<double>().swap(ordered_phi_);
-  std::vector<double>().swap(ordered_areas_);
   std::vector<double>().swap(ordered_weights_);
 }
 

@@ -189,10 +189,9 @@ SelectiveSegmentation<PointT>::publishNormals()
   // Every vertex represents at least one point: a point has a normal if a vertex has;
   // the point normals themselves are built on the first getPointNormals().
   normals_.reset();
-  const bool any =
-      std::any_of(vertex_normals_.begin(),
-                  vertex_normals_.end(),
-                  [](const Eigen::Vector3f& n) { return n.allFinite(); });
+  const bool any = std::any_of(vertex_normals_.begin(),
+                               vertex_normals_.end(),
+                               [](const Eigen::Vector3f& n) { return n.allFinite(); });
   result_.median_spacing = medianEdgeLength(positions, tri.triangles);
   if (!any)
     return fail("extract",
@@ -208,14 +207,11 @@ SelectiveSegmentation<PointT>::buildOctree()
   const SphericalTriangulation& tri = delaunay_.getTriangulation();
   const std::size_t num_vertices = tri.vertex_positions.size();
   auto vertices = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
-  auto normals = pcl::make_shared<NormalCloud>();
   vertices->resize(num_vertices);
-  normals->resize(num_vertices);
   Eigen::Array3f lo = Eigen::Array3f::Constant(std::numeric_limits<float>::max());
   Eigen::Array3f hi = -lo;
   for (std::size_t v = 0; v < num_vertices; ++v) {
     (*vertices)[v].getVector3fMap() = tri.vertex_positions[v];
-    (*normals)[v].getNormalVector3fMap() = vertex_normals_[v];
     if (vertex_normals_[v].allFinite()) {
       lo = lo.min(tri.vertex_positions[v].array());
       hi = hi.max(tri.vertex_positions[v].array());
@@ -241,12 +237,21 @@ SelectiveSegmentation<PointT>::buildOctree()
 
   octree_ = pcl::make_shared<Octree>(resolution);
   octree_->setInputCloud(vertices);
-  octree_->setInputNormals(normals, vertex_areas_);
+  // The vertex normals are lent to the octree, not copied into a pcl::Normal cloud
+  // (32 bytes per vertex, at the pipeline's peak of memory), and taken back once the
+  // leaves are made: the octree is only handed out const, so it never reads them again.
+  const typename Octree::NormalVectorsConstPtr lent(
+      std::shared_ptr<const Vector3fVector>(), &vertex_normals_);
+  octree_->setInputNormals(lent, vertex_areas_);
   octree_->setNumberOfThreads(static_cast<unsigned int>(params_.num_threads));
-  if (!octree_->addPointsFromInputCloud())
+  const bool inserted = octree_->addPointsFromInputCloud();
+  if (inserted)
+    octree_->computeAdaptiveLeaves(
+        params_.max_normal_std_dev,
+        static_cast<std::size_t>(params_.min_points_to_split));
+  octree_->setInputNormals(typename Octree::NormalVectorsConstPtr(), vertex_areas_);
+  if (!inserted)
     return fail("extract", "no point with a normal to insert into the octree");
-  octree_->computeAdaptiveLeaves(params_.max_normal_std_dev,
-                                 static_cast<std::size_t>(params_.min_points_to_split));
 
   vertex_leaf_.assign(num_vertices, -1);
   const auto& leaves = octree_->getAdaptiveLeaves();
@@ -322,6 +327,7 @@ SelectiveSegmentation<PointT>::fillMeshAndLeaves(
   const auto num_triangles = static_cast<std::ptrdiff_t>(tri.triangles.size());
   const Eigen::Matrix3f to_cloud = sensorToCloud();
   Vector3fVector label_normals; // sensor frame, like the triangle normals
+  label_normals.reserve(result_.segments.size());
   for (const auto& s : result_.segments)
     label_normals.push_back(to_cloud.transpose() * s.normal);
   classifyTriangles(tri.triangles,
@@ -417,7 +423,6 @@ SelectiveSegmentation<PointT>::mergeAndLabel()
     if (vertex_segment[v] >= 0)
       vertex_labels[v] = segment_label[vertex_segment[v]];
   fillMeshAndLeaves(vertex_labels, leaf_segment, segment_label);
-
 }
 
 template <typename PointT>
