@@ -7,12 +7,16 @@
 // libFuzzer target: SelectiveSegmentation::extract() on arbitrary points, parameters
 // and sensor poses. Beyond crashes, hangs and sanitizer findings it aborts on garbage:
 // an accepted invalid parameter, a refused valid one on a usable cloud, or a result
-// whose labels, counts, clusters and mesh disagree.
+// whose labels, counts, clusters and mesh disagree. With bit 1 of the last parameter
+// slot set (and not every parameter overridden), it also checks update(): extract() on
+// the first three quarters of the points, update() with the rest, must give exactly
+// extract() on the union with the first run's finest voxel
+// (docs/incremental_update.md).
 //
 // Input layout (all little endian; missing bytes read as zero):
 //   byte 0        point encoding: 0 raw float32 x y z; 1 int8 grid (x/16, y/16,
-//                 1 + z/16); 2 int16 grid (/1024, z shifted to 1 + z/1024); 3 float32 x y
-//                 and a range (a direction plus depth: many points per ray)
+//                 1 + z/16); 2 int16 grid (/1024, z shifted to 1 + z/1024); 3 float32 x
+//                 y and a range (a direction plus depth: many points per ray)
 //   byte 1        which parameters to override (bit i: parameter i below)
 //   bytes 2-3     sensor pose: 0 = identity, else a quaternion and origin from bytes
 //   then          13 parameter slots of 8 bytes (double, or int in the low 4 bytes)
@@ -36,9 +40,7 @@ struct Reader {
   const std::uint8_t* data;
   std::size_t size;
   std::size_t at = 0;
-  template <typename T>
-  T
-  get()
+  template <typename T> T get()
   {
     T value{};
     unsigned char bytes[sizeof(T)] = {};
@@ -47,11 +49,7 @@ struct Reader {
     std::memcpy(&value, bytes, sizeof(T));
     return value;
   }
-  std::size_t
-  left() const
-  {
-    return size - at;
-  }
+  std::size_t left() const { return size - at; }
 };
 
 void
@@ -61,6 +59,88 @@ check(bool condition, const char* what)
     std::fprintf(stderr, "fuzz_segmentation: invariant violated: %s\n", what);
     std::abort();
   }
+}
+
+/** The same bits (NaN normals of degenerate triangles compare equal to themselves). */
+template <typename Vector>
+bool
+sameBits(const Vector& a, const Vector& b)
+{
+  return a.size() == b.size() &&
+         (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(a[0])) == 0);
+}
+
+/** update() against extract() on the union: the same result, array for array. */
+void
+checkUpdate(const pcl::PointCloud<pcl::PointXYZ>& cloud,
+            const SelectiveSegmentationParameters& params,
+            const Eigen::Affine3f* pose)
+{
+  const std::size_t first_new = cloud.size() * 3 / 4;
+  auto old_points = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  pcl::PointCloud<pcl::PointXYZ> new_points;
+  old_points->points.assign(cloud.begin(), cloud.begin() + first_new);
+  new_points.points.assign(cloud.begin() + first_new, cloud.end());
+  for (auto* c : {old_points.get(), &new_points}) {
+    c->width = static_cast<std::uint32_t>(c->size());
+    c->height = 1;
+    c->is_dense = false;
+  }
+  SelectiveSegmentation<pcl::PointXYZ> seg;
+  seg.setParameters(params);
+  if (pose)
+    seg.setSensorPose(*pose);
+  seg.setInputCloud(old_points);
+  std::vector<pcl::PointIndices> clusters;
+  if (!seg.extract(clusters))
+    return; // nothing to update (checked: update() refuses)
+  SelectiveSegmentationParameters kept = params;
+  if (!(kept.min_voxel_size > 0.0))
+    kept.min_voxel_size = seg.getResult().min_voxel_size;
+  const bool updated = seg.update(new_points, clusters);
+
+  auto all = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>(cloud);
+  SelectiveSegmentation<pcl::PointXYZ> ref;
+  ref.setParameters(kept);
+  if (pose)
+    ref.setSensorPose(*pose);
+  ref.setInputCloud(all);
+  std::vector<pcl::PointIndices> ref_clusters;
+  const bool ref_ok = ref.extract(ref_clusters);
+  check(updated == ref_ok, "update() and extract() on the union disagree on success");
+  if (!updated)
+    return;
+  const auto& a = seg.getResult();
+  const auto& b = ref.getResult();
+  check(a.labels == b.labels, "update(): labels differ from extract() on the union");
+  check(a.segments.size() == b.segments.size(), "update(): segment count differs");
+  for (std::size_t s = 0; s < a.segments.size(); ++s)
+    check(a.segments[s].num_points == b.segments[s].num_points &&
+              a.segments[s].normal == b.segments[s].normal &&
+              a.segments[s].area == b.segments[s].area,
+          "update(): a segment differs");
+  check(a.leaves.size() == b.leaves.size(), "update(): leaf count differs");
+  for (std::size_t l = 0; l < a.leaves.size(); ++l)
+    check(a.leaves[l].centre == b.leaves[l].centre &&
+              a.leaves[l].label == b.leaves[l].label &&
+              a.leaves[l].area == b.leaves[l].area,
+          "update(): a leaf differs");
+  check(a.mesh.triangles == b.mesh.triangles, "update(): mesh triangles differ");
+  check(a.mesh.neighbours == b.mesh.neighbours, "update(): mesh adjacency differs");
+  check(a.mesh.labels == b.mesh.labels, "update(): mesh labels differ");
+  check(a.mesh.classes == b.mesh.classes, "update(): mesh classes differ");
+  check(sameBits(a.mesh.areas, b.mesh.areas), "update(): mesh areas differ");
+  check(sameBits(a.mesh.normals, b.mesh.normals), "update(): mesh normals differ");
+  check(a.min_voxel_size == b.min_voxel_size && a.num_vertices == b.num_vertices &&
+            a.counts.labeled == b.counts.labeled &&
+            a.counts.non_finite == b.counts.non_finite &&
+            a.counts.behind_sensor == b.counts.behind_sensor &&
+            a.counts.shared_vertex == b.counts.shared_vertex,
+        "update(): the counts differ");
+  check(clusters.size() == ref_clusters.size(), "update(): cluster count differs");
+  for (std::size_t s = 0; s < clusters.size(); ++s)
+    check(clusters[s].indices == ref_clusters[s].indices,
+          "update(): a cluster differs");
 }
 
 } // namespace
@@ -114,9 +194,9 @@ LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size)
     p.num_threads = i32(10) % 4; // valid 0-3 or invalid negatives: no thread storms
     p.edge_triangle_normal =
         static_cast<pcl::selective_seg::EdgeTriangleNormal>(slot[11] & 0xff);
-    p.delaunay_backend = static_cast<pcl::selective_seg::DelaunayBackend>(slot[12] & 0xff);
-  }
-  else {
+    p.delaunay_backend =
+        static_cast<pcl::selective_seg::DelaunayBackend>(slot[12] & 0xff);
+  } else {
     p.edge_triangle_normal =
         static_cast<pcl::selective_seg::EdgeTriangleNormal>(slot[11] & 1);
     if (slot[12] & 1)
@@ -126,6 +206,7 @@ LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size)
   if (p.delaunay_backend == pcl::selective_seg::DelaunayBackend::Vtk)
     p.delaunay_backend = pcl::selective_seg::DelaunayBackend::Sweep;
   const bool valid = p.validate();
+  const bool check_update = overrides != 0xff && (slot[12] & 2) != 0;
 
   auto cloud = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
   const std::size_t stride = encoding == 1 ? 3 : encoding == 2 ? 6 : 12;
@@ -160,8 +241,8 @@ LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size)
 
   SelectiveSegmentation<pcl::PointXYZ> seg;
   seg.setParameters(p);
+  Eigen::Affine3f pose = Eigen::Affine3f::Identity();
   if (pose_bytes != 0) {
-    Eigen::Affine3f pose = Eigen::Affine3f::Identity();
     const Eigen::Quaternionf q(1.0f,
                                (pose_bytes & 0xf) / 8.0f - 1.0f,
                                ((pose_bytes >> 4) & 0xf) / 8.0f - 1.0f,
@@ -211,5 +292,7 @@ LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size)
     check(leaf.label >= 1 && leaf.label <= r.segments.size() && leaf.normal.allFinite(),
           "leaf label or normal");
   check(std::isfinite(r.min_voxel_size) && r.min_voxel_size > 0.0, "voxel size");
+  if (check_update)
+    checkUpdate(*cloud, p, pose_bytes != 0 ? &pose : nullptr);
   return 0;
 }

@@ -66,8 +66,7 @@ segmentationInput(const pcl::PointCloud<pcl::PointXYZ>& cloud, std::uint8_t enco
                                  static_cast<std::int16_t>(p.y * 1024.0f),
                                  static_cast<std::int16_t>((p.z - 1.0f) * 1024.0f)};
       bytes.append(reinterpret_cast<const char*>(v), sizeof v);
-    }
-    else
+    } else
       bytes.append(reinterpret_cast<const char*>(p.data), 3 * sizeof(float));
   }
   return bytes;
@@ -96,13 +95,18 @@ main(int argc, char** argv)
       return 1;
     }
     const std::string stem = fs::path(argv[a]).stem().string();
-    const int cx = static_cast<int>(cloud.width) / 2, cy = static_cast<int>(cloud.height) / 2;
+    const int cx = static_cast<int>(cloud.width) / 2,
+              cy = static_cast<int>(cloud.height) / 2;
     // Segmentation: a dense 16 x 12 window and a sparse one across the whole view.
     writeAll(seg_dir / (stem + "_window_f32"),
              segmentationInput(window(cloud, cx - 8, cy - 6, 16, 12, 1), 0));
-    writeAll(seg_dir / (stem + "_sparse_i16"),
-             segmentationInput(window(cloud, 0, 0, 20, 15,
-                                      std::max<int>(1, cloud.width / 20)), 2));
+    const std::string sparse = segmentationInput(
+        window(cloud, 0, 0, 20, 15, std::max<int>(1, cloud.width / 20)), 2);
+    writeAll(seg_dir / (stem + "_sparse_i16"), sparse);
+    // The same with the update() check on (bit 1 of the last parameter slot).
+    std::string update = sparse;
+    update[4 + 12 * 8] = 2;
+    writeAll(seg_dir / (stem + "_sparse_i16_update"), update);
     // Reading: the same small window in every format the tool reads.
     const auto small = window(cloud, cx - 5, cy - 4, 10, 8, 3);
     const auto with_format = [&](char format, const fs::path& file) {
