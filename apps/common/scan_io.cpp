@@ -320,7 +320,10 @@ pcdHeaderUsable(const std::string& path, std::string& error)
 
 /** Checks a PLY header line by line before PCL reads it (its parser trusts the header:
  * a negative element count sends it into a loop of about 2^64 steps) and counts the
- * values its elements promise. */
+ * values its elements promise. PCL also takes `obj_info num_cols N` / `num_rows N` as
+ * the cloud's width and height (with atoi) and sizes its data by them: they must be
+ * positive integers whose product is the vertex count, or PCL writes past its data
+ * (an assertion in PCL's PLY reader aborts the process). */
 bool
 plyHeaderUsable(const std::string& path, std::string& error)
 {
@@ -332,18 +335,40 @@ plyHeaderUsable(const std::string& path, std::string& error)
     return false;
   }
   unsigned long long values = 0;
-  long long count = 0;
+  long long count = 0, vertices = -1, cols = -1, rows = -1;
   bool in_element = false;
   while (std::getline(in, line)) {
     std::istringstream words(line);
     std::string keyword;
     words >> keyword;
-    if (keyword == "end_header")
+    if (keyword == "end_header") {
+      if ((cols >= 0 || rows >= 0) &&
+          (cols < 0 || rows < 0 || cols * rows != vertices)) {
+        error = what + "its obj_info num_cols (" + std::to_string(cols) +
+                ") and num_rows (" + std::to_string(rows) +
+                ") do not multiply to its " + std::to_string(std::max(vertices, 0ll)) +
+                " vertices: the header is corrupt";
+        return false;
+      }
       return plausibleSize(path, values, bytesAfter(path, in.tellg()), error);
-    if (keyword == "comment" || keyword == "obj_info")
+    }
+    if (keyword == "comment")
       continue;
     bool ok = false;
-    if (keyword == "format") {
+    if (keyword == "obj_info") {
+      // PCL splits this line at spaces and tabs only.
+      std::string key, number, rest;
+      std::istringstream fields(line.substr(line.find("obj_info") + 8));
+      fields >> key;
+      if (key != "num_cols" && key != "num_rows")
+        continue;
+      ok = static_cast<bool>(fields >> number) && !(fields >> rest) &&
+           line.find_first_of("\v\f") == std::string::npos && number.size() <= 9 &&
+           number.find_first_not_of("0123456789") == std::string::npos &&
+           std::stoll(number) > 0;
+      if (ok)
+        (key == "num_cols" ? cols : rows) = std::stoll(number);
+    } else if (keyword == "format") {
       std::string format, version;
       ok = static_cast<bool>(words >> format >> version) &&
            (format == "ascii" || format == "binary_little_endian" ||
@@ -352,6 +377,8 @@ plyHeaderUsable(const std::string& path, std::string& error)
       std::string name, rest;
       ok = static_cast<bool>(words >> name >> count) && !(words >> rest) &&
            count >= 0 && count <= (1ll << 40);
+      if (ok && name == "vertex")
+        vertices = count;
       in_element = true;
     } else if (keyword == "property" && in_element) {
       std::string type, name;
@@ -359,7 +386,8 @@ plyHeaderUsable(const std::string& path, std::string& error)
       values += static_cast<unsigned long long>(count);
     }
     if (!ok) {
-      error = what + "malformed or implausible header line '" + line + "'";
+      error =
+          what + "malformed or implausible header line '" + line.substr(0, 60) + "'";
       return false;
     }
   }

@@ -338,6 +338,42 @@ TEST_F(ToolFailure, OutputsThatCollideAreUsageErrors)
   EXPECT_TRUE(outputs().empty());
 }
 
+// PCL's PLY reader takes `obj_info num_cols N` / `num_rows N` (atoi) as the cloud's
+// layout and sizes its data by them; a value that does not match the vertex count made
+// it write past its data and abort on an assertion (exit 134). Found by fuzzing.
+TEST_F(ToolFailure, PlyLayoutMustMatchTheVertices)
+{
+  const fs::path in = dir / "in";
+  pcl::io::savePLYFileBinary((in / "organized.ply").string(), wall()); // 40 x 30
+  std::string good = readFile(in / "organized.ply");
+  const std::string after = "comment PCL generated\n";
+  ASSERT_NE(good.find(after), std::string::npos) << good.substr(0, 300);
+  good.insert(good.find(after) + after.size(),
+              "obj_info num_cols 40\nobj_info num_rows 30\n");
+  writeFile(in / "organized.ply", good);
+  // With a layout that matches its vertices, the file reads.
+  const Outcome ok = run(shellQuoted(in / "organized.ply") + " -ignore_viewpoint");
+  EXPECT_EQ(ok.code, 0) << ok.messages;
+  const auto replaced = [&](const std::string& from, const std::string& to) {
+    std::string s = good;
+    s.replace(s.find(from), from.size(), to);
+    return s;
+  };
+  const struct {
+    const char* name;
+    std::string content;
+  } cases[] = {
+      {"rows_word.ply", replaced("obj_info num_rows 30", "obj_info num_rows t 1")},
+      {"rows_zero.ply", replaced("obj_info num_rows 30", "obj_info num_rows 0")},
+      {"rows_wrong.ply", replaced("obj_info num_rows 30", "obj_info num_rows 29")},
+      {"cols_only.ply", replaced("obj_info num_rows 30", "comment no rows")},
+  };
+  for (const auto& c : cases) {
+    writeFile(in / c.name, c.content);
+    expectRejected(in / c.name, "cannot read");
+  }
+}
+
 // A lying header must not make the tool allocate what the header claims.
 TEST_F(ToolFailure, LyingHeadersUseBoundedMemory)
 {
