@@ -338,6 +338,18 @@ plyHeaderUsable(const std::string& path, std::string& error)
   long long count = 0, vertices = -1, cols = -1, rows = -1;
   bool in_element = false;
   while (std::getline(in, line)) {
+    // PCL's PLY reader splits some lines at spaces and tabs only and asserts on what it
+    // finds: no leading white space, no control characters but a final CR.
+    const std::string body =
+        !line.empty() && line.back() == '\r' ? line.substr(0, line.size() - 1) : line;
+    if (!body.empty() && (std::isspace(static_cast<unsigned char>(body[0])) ||
+                          std::any_of(body.begin(), body.end(), [](char c) {
+                            const auto u = static_cast<unsigned char>(c);
+                            return (u < 0x20 && c != '\t') || u == 0x7f;
+                          }))) {
+      error = what + "malformed header line (white space first or control characters)";
+      return false;
+    }
     std::istringstream words(line);
     std::string keyword;
     words >> keyword;
