@@ -123,6 +123,26 @@ plausibleSize(const std::string& path,
   return false;
 }
 
+/** A control character other than a tab (PCL's header readers split lines at tabs). */
+bool
+isControlCharacter(char c)
+{
+  const auto u = static_cast<unsigned char>(c);
+  return (u < 0x20 && c != '\t') || u == 0x7f;
+}
+
+/** \a word as an unsigned number of at most \a max_digits decimal digits, nothing else
+ * (no sign, no space, no exponent: PCL reads such words differently, or to garbage). */
+bool
+readDigits(const std::string& word, std::size_t max_digits, unsigned long long& value)
+{
+  if (word.empty() || word.size() > max_digits ||
+      word.find_first_not_of("0123456789") != std::string::npos)
+    return false;
+  value = std::stoull(word);
+  return true;
+}
+
 /** The header keyword PCL 1.13's PCDReader::readHeader takes a line for. It matches
  * keywords by prefix ("COUNTS" is a COUNT line) and goes on reading lines after DATA
  * until one it does not know; our check must see the lines it sees, the same way. */
@@ -187,8 +207,7 @@ pcdSizesPlausible(const std::string& path, std::string& error)
     // numbers with >>, which also stops at other white space: a header line with
     // control characters would be counted one way and read another.
     if (std::any_of(line.begin(), line.end(), [](char c) {
-          const auto u = static_cast<unsigned char>(c);
-          return (u < 0x20 && c != '\t' && c != '\r') || u == 0x7f;
+          return c != '\r' && isControlCharacter(c);
         }))
       return corrupt("a header line holds control characters");
     if (key == "#")
@@ -200,25 +219,16 @@ pcdSizesPlausible(const std::string& path, std::string& error)
       rest.push_back(word);
     const auto numbers = [&](std::vector<unsigned long long>& out) {
       for (const auto& w : rest) {
-        if (w.empty() || w.find_first_not_of("0123456789") != std::string::npos ||
-            w.size() > 12)
+        unsigned long long value = 0;
+        if (!readDigits(w, 12, value))
           return false;
-        out.push_back(std::stoull(w));
+        out.push_back(value);
       }
       return true;
     };
     std::vector<unsigned long long> one;
-    static const std::vector<std::string> keys = {"VERSION",
-                                                  "FIELDS",
-                                                  "SIZE",
-                                                  "TYPE",
-                                                  "COUNT",
-                                                  "WIDTH",
-                                                  "HEIGHT",
-                                                  "VIEWPOINT",
-                                                  "POINTS"};
-    if (std::find(keys.begin(), keys.end(), key) != keys.end() &&
-        !seen.insert(key).second)
+    // Every header keyword once (after DATA, any keyword was refused above).
+    if (key != "DATA" && !seen.insert(key).second)
       return corrupt("it has two " + key + " lines");
     if (key == "FIELDS")
       fields = rest;
@@ -343,10 +353,7 @@ plyHeaderUsable(const std::string& path, std::string& error)
     const std::string body =
         !line.empty() && line.back() == '\r' ? line.substr(0, line.size() - 1) : line;
     if (!body.empty() && (std::isspace(static_cast<unsigned char>(body[0])) ||
-                          std::any_of(body.begin(), body.end(), [](char c) {
-                            const auto u = static_cast<unsigned char>(c);
-                            return (u < 0x20 && c != '\t') || u == 0x7f;
-                          }))) {
+                          std::any_of(body.begin(), body.end(), isControlCharacter))) {
       error = what + "malformed header line (white space first or control characters)";
       return false;
     }
@@ -368,18 +375,16 @@ plyHeaderUsable(const std::string& path, std::string& error)
       continue;
     bool ok = false;
     if (keyword == "obj_info") {
-      // PCL splits this line at spaces and tabs only.
+      // PCL splits this line at spaces and tabs only (other white space was refused).
       std::string key, number, rest;
-      std::istringstream fields(line.substr(line.find("obj_info") + 8));
-      fields >> key;
+      words >> key;
       if (key != "num_cols" && key != "num_rows")
         continue;
-      ok = static_cast<bool>(fields >> number) && !(fields >> rest) &&
-           line.find_first_of("\v\f") == std::string::npos && number.size() <= 9 &&
-           number.find_first_not_of("0123456789") == std::string::npos &&
-           std::stoll(number) > 0;
+      unsigned long long value = 0;
+      ok = static_cast<bool>(words >> number) && !(words >> rest) &&
+           readDigits(number, 9, value) && value > 0;
       if (ok)
-        (key == "num_cols" ? cols : rows) = std::stoll(number);
+        (key == "num_cols" ? cols : rows) = static_cast<long long>(value);
     } else if (keyword == "format") {
       std::string format, version;
       ok = static_cast<bool>(words >> format >> version) &&
