@@ -30,6 +30,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
+#include <vector>
 
 namespace {
 
@@ -61,13 +62,21 @@ check(bool condition, const char* what)
   }
 }
 
-/** The same bits (NaN normals of degenerate triangles compare equal to themselves). */
-template <typename Vector>
+/** The same bits: extreme inputs give infinite areas and NaN normals and centres,
+ * which compare unequal to themselves. */
+template <typename T>
 bool
-sameBits(const Vector& a, const Vector& b)
+sameBits(const T& a, const T& b)
+{
+  return std::memcmp(&a, &b, sizeof a) == 0;
+}
+
+template <typename T>
+bool
+sameBits(const std::vector<T>& a, const std::vector<T>& b)
 {
   return a.size() == b.size() &&
-         (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(a[0])) == 0);
+         (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
 }
 
 /** update() against extract() on the union: the same result, array for array. */
@@ -114,20 +123,16 @@ checkUpdate(const pcl::PointCloud<pcl::PointXYZ>& cloud,
   const auto& b = ref.getResult();
   check(a.labels == b.labels, "update(): labels differ from extract() on the union");
   check(a.segments.size() == b.segments.size(), "update(): segment count differs");
-  // Bitwise: extreme inputs give infinite areas and NaN centres, equal to themselves.
-  const auto same = [](const auto& x, const auto& y) {
-    return std::memcmp(&x, &y, sizeof x) == 0;
-  };
   for (std::size_t s = 0; s < a.segments.size(); ++s)
     check(a.segments[s].num_points == b.segments[s].num_points &&
-              same(a.segments[s].normal, b.segments[s].normal) &&
-              same(a.segments[s].area, b.segments[s].area),
+              sameBits(a.segments[s].normal, b.segments[s].normal) &&
+              sameBits(a.segments[s].area, b.segments[s].area),
           "update(): a segment differs");
   check(a.leaves.size() == b.leaves.size(), "update(): leaf count differs");
   for (std::size_t l = 0; l < a.leaves.size(); ++l)
-    check(same(a.leaves[l].centre, b.leaves[l].centre) &&
+    check(sameBits(a.leaves[l].centre, b.leaves[l].centre) &&
               a.leaves[l].label == b.leaves[l].label &&
-              same(a.leaves[l].area, b.leaves[l].area),
+              sameBits(a.leaves[l].area, b.leaves[l].area),
           "update(): a leaf differs");
   check(a.mesh.triangles == b.mesh.triangles, "update(): mesh triangles differ");
   check(a.mesh.neighbours == b.mesh.neighbours, "update(): mesh adjacency differs");
