@@ -99,23 +99,22 @@ BM_Update(benchmark::State& state)
   state.counters["points"] = static_cast<double>(s.all->size());
 }
 
+/** Both benchmarks on the same sizes and settings, so that they pair up. */
+void
+sizes(benchmark::internal::Benchmark* b)
+{
+  b->Arg(46000)
+      ->Arg(300000)
+      ->Arg(1000000)
+      ->Unit(benchmark::kMillisecond)
+      ->UseRealTime()
+      ->Repetitions(3)
+      ->ReportAggregatesOnly(true);
+}
+
 } // namespace
 
-BENCHMARK(BM_ExtractUnion)
-    ->Arg(46000)
-    ->Arg(300000)
-    ->Arg(1000000)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime()
-    ->Repetitions(3)
-    ->ReportAggregatesOnly(true);
-BENCHMARK(BM_Update)
-    ->Arg(46000)
-    ->Arg(300000)
-    ->Arg(1000000)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime()
-    ->Repetitions(3)
-    ->ReportAggregatesOnly(true);
+BENCHMARK(BM_ExtractUnion)->Apply(sizes);
+BENCHMARK(BM_Update)->Apply(sizes);
 
 BENCHMARK_MAIN();
