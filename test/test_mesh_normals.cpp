@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -458,6 +459,39 @@ TEST(MeshNormals, MedianEdgeLength)
               std::sqrt(5.0),
               1e-6);
   EXPECT_EQ(medianEdgeLength(positions, {}), 0.0);
+}
+
+TEST(MeshNormals, MedianEdgeLengthIsTheSampledEdgesMedianForAnyThreadCount)
+{
+  // The selection must give, to the bit, the middle element of the sorted lengths of
+  // the sampled edges (every stride-th triangle over 100,000 triangles), with ties and
+  // lengths spread over many binades.
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> coordinate(-1.f, 1.f);
+  std::uniform_int_distribution<int> scale(-20, 20);
+  for (const std::size_t num_triangles : {1u, 2u, 5u, 999u, 100000u, 250001u}) {
+    Vector3fVector positions(600);
+    for (auto& p : positions)
+      p = Eigen::Vector3f(coordinate(rng), coordinate(rng), coordinate(rng)) *
+          std::ldexp(1.f, scale(rng));
+    positions[1] = positions[0]; // zero-length edges
+    std::uniform_int_distribution<pcl::index_t> vertex(0, 599);
+    std::vector<pcl::selective_seg::Triangle> triangles(num_triangles);
+    for (auto& t : triangles)
+      t = {vertex(rng), vertex(rng), vertex(rng)};
+    const std::size_t stride = std::max<std::size_t>(1, num_triangles / 100000);
+    std::vector<double> lengths;
+    for (std::size_t k = 0; k < num_triangles; k += stride)
+      for (int i = 0; i < 3; ++i)
+        lengths.push_back((positions[triangles[k][i]].cast<double>() -
+                           positions[triangles[k][(i + 1) % 3]].cast<double>())
+                              .norm());
+    std::sort(lengths.begin(), lengths.end());
+    const double expected = lengths[lengths.size() / 2];
+    for (const int threads : {1, 2, 3})
+      EXPECT_EQ(medianEdgeLength(positions, triangles, threads), expected)
+          << num_triangles << " triangles, " << threads << " threads";
+  }
 }
 
 int

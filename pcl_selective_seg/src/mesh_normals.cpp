@@ -10,6 +10,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 
 namespace pcl {
@@ -415,25 +417,55 @@ updateVertexNormals(const std::vector<Triangle>& triangles,
 
 double
 medianEdgeLength(const Vector3fVector& positions,
-                 const std::vector<Triangle>& triangles)
+                 const std::vector<Triangle>& triangles,
+                 int num_threads)
 {
   if (triangles.empty())
     return 0.0;
   // Large meshes: every stride-th triangle (a fixed function of the canonical triangle
   // order) still gives over 300,000 edges, plenty for a median.
   const std::size_t stride = std::max<std::size_t>(1, triangles.size() / 100000);
-  std::vector<double> lengths;
-  lengths.reserve(3 * (triangles.size() / stride + 1));
-  for (std::size_t k = 0; k < triangles.size(); k += stride) {
-    const Triangle& t = triangles[k];
+  const std::ptrdiff_t sampled =
+      static_cast<std::ptrdiff_t>((triangles.size() + stride - 1) / stride);
+  // The median of the squared lengths, then one square root: sqrt is monotone and
+  // correctly rounded, and Eigen's norm() is sqrt(squaredNorm()), so this is the
+  // median of the lengths to the bit.
+  std::vector<double> squares(3 * static_cast<std::size_t>(sampled));
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(threads(num_threads)) schedule(static) \
+    if (sampled >= 65536)
+#endif
+  for (std::ptrdiff_t j = 0; j < sampled; ++j) {
+    const Triangle& t = triangles[static_cast<std::size_t>(j) * stride];
     for (int i = 0; i < 3; ++i)
-      lengths.push_back(
+      squares[3 * j + i] =
           (positions[t[i]].cast<double>() - positions[t[(i + 1) % 3]].cast<double>())
-              .norm());
+              .squaredNorm();
   }
-  auto middle = lengths.begin() + static_cast<std::ptrdiff_t>(lengths.size() / 2);
-  std::nth_element(lengths.begin(), middle, lengths.end());
-  return *middle;
+  // Selection of the element of rank n / 2: squares are non-negative, so their bit
+  // patterns order as they do. A histogram of the top 16 bits finds the bucket that
+  // holds the rank; only that bucket is partitioned.
+  const std::size_t rank = squares.size() / 2;
+  const auto bits = [](double v) {
+    std::uint64_t b;
+    std::memcpy(&b, &v, sizeof b);
+    return b;
+  };
+  std::vector<std::uint32_t> histogram(1u << 16, 0);
+  for (const double v : squares)
+    ++histogram[bits(v) >> 48];
+  std::size_t below = 0;
+  std::uint64_t bucket = 0;
+  while (below + histogram[bucket] <= rank)
+    below += histogram[bucket++];
+  std::vector<double> candidates;
+  candidates.reserve(histogram[bucket]);
+  for (const double v : squares)
+    if ((bits(v) >> 48) == bucket)
+      candidates.push_back(v);
+  const auto middle = candidates.begin() + static_cast<std::ptrdiff_t>(rank - below);
+  std::nth_element(candidates.begin(), middle, candidates.end());
+  return std::sqrt(*middle);
 }
 
 } // namespace selective_seg

@@ -154,9 +154,12 @@ updateVertexNormalsOverRings(const std::vector<Triangle>& triangles,
                              Vector3fVector& vertex_normals);
 
 /** \brief Median 3-D length of the triangles' edges [m] (each interior edge counted
- * twice); 0 for an empty mesh. The octree's automatic minimum voxel size scales it. */
+ * twice; over 100,000 triangles, those of every stride-th triangle, stride =
+ * triangles / 100,000); 0 for an empty mesh. The octree's automatic minimum voxel size
+ * scales it. Threads: 0 = all cores; the result does not depend on them. */
 PCL_EXPORTS double medianEdgeLength(const Vector3fVector& positions,
-                                    const std::vector<Triangle>& triangles);
+                                    const std::vector<Triangle>& triangles,
+                                    int num_threads = 1);
 
 } // namespace selective_seg
 } // namespace pcl

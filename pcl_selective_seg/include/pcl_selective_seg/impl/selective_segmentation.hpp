@@ -192,7 +192,8 @@ SelectiveSegmentation<PointT>::publishNormals()
   const bool any = std::any_of(vertex_normals_.begin(),
                                vertex_normals_.end(),
                                [](const Eigen::Vector3f& n) { return n.allFinite(); });
-  result_.median_spacing = medianEdgeLength(positions, tri.triangles);
+  result_.median_spacing =
+      medianEdgeLength(positions, tri.triangles, params_.num_threads);
   if (!any)
     return fail("extract",
                 "every triangle is degenerate (zero 3-D area): the points give no "
@@ -357,10 +358,11 @@ SelectiveSegmentation<PointT>::fillMeshAndLeaves(
   triangle_areas_.clear();
 
   const auto& leaves = octree_->getAdaptiveLeaves();
+  const Eigen::Affine3f sensor_pose = delaunay_.getSensorPose();
   result_.leaves.resize(leaves.size());
   for (std::size_t l = 0; l < leaves.size(); ++l) {
     OctreeLeaf& out = result_.leaves[l];
-    out.centre = delaunay_.getSensorPose() * octree_->getVoxelCentre(leaves[l]);
+    out.centre = sensor_pose * octree_->getVoxelCentre(leaves[l]);
     out.size = static_cast<float>(octree_->getVoxelSideLength(leaves[l].depth));
     out.depth = leaves[l].depth;
     out.label = segment_label[leaf_segment[l]];
