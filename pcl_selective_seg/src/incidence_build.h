@@ -19,6 +19,27 @@ namespace pcl {
 namespace selective_seg {
 namespace detail {
 
+/** \brief An array stored in blocks of 4,096 entries: a large temporary array that can
+ * reuse the memory earlier stages freed to the allocator (one block of it is below
+ * malloc's mapping threshold) instead of mapping fresh pages on top of it. */
+template <typename T>
+class BlockArray {
+public:
+  void resize(std::size_t size)
+  {
+    blocks_.resize((size + kMask) >> kShift);
+    for (std::size_t b = 0; b < blocks_.size(); ++b)
+      blocks_[b].resize(std::min<std::size_t>(kMask + 1, size - (b << kShift)));
+  }
+  T& operator[](std::size_t i) { return blocks_[i >> kShift][i & kMask]; }
+  const T& operator[](std::size_t i) const { return blocks_[i >> kShift][i & kMask]; }
+
+private:
+  static constexpr std::size_t kShift = 12;
+  static constexpr std::size_t kMask = (std::size_t{1} << kShift) - 1;
+  std::vector<std::vector<T>> blocks_;
+};
+
 /** \brief Buckets by a counting sort: emit(item, f) calls f(group, value) for each entry
  * of the item; bucket g is values[offsets[g] .. offsets[g + 1]), its entries in the
  * order of their items (and of the calls within an item).
@@ -27,14 +48,14 @@ namespace detail {
  * chunk counted and then filled by its thread from its own cursors (a chunk's cursor
  * for a group starts after the earlier chunks' entries): the same buckets as one
  * thread gives. */
-template <typename Value, typename Emit>
+template <typename Value, typename Emit, typename Values = std::vector<Value>>
 void
 buildBuckets(std::size_t num_items,
              std::size_t num_groups,
              Emit emit,
              int num_threads,
              std::vector<std::size_t>& offsets,
-             std::vector<Value>& values)
+             Values& values)
 {
   const std::size_t chunks =
       num_threads > 1 && num_items >= 65536 ? static_cast<std::size_t>(num_threads) : 1;

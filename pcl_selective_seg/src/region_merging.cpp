@@ -74,25 +74,38 @@ seedOrder(const std::vector<pcl::index_t>& vertex_leaf, std::size_t num_leaves)
   return order;
 }
 
+/** A triangle listed under a leaf, with the leaves of its vertices (-1: none) kept
+ * beside it: the growth reads them for every triangle it visits, and a copy next to
+ * the triangle id saves it three scattered reads per visit. */
+struct LeafTriangle {
+  std::array<pcl::index_t, 3> leaves;
+  pcl::index_t triangle;
+};
+
 /** The triangles at each leaf that can matter to the growth: every triangle whose
  * vertices lie in at least two leaves, listed once under each distinct leaf of its
  * vertices, in increasing triangle order. A triangle within one leaf is never an edge
  * triangle of the segment holding that leaf, so leaving it out changes nothing. */
 struct LeafTriangles {
   const MergeInput& in;
-  Incidence leaf_triangles;
+  std::vector<std::size_t> offsets; ///< #L + 1: leaf l's entries are [offsets[l], offsets[l + 1])
+  detail::BlockArray<LeafTriangle> entries;
 
   LeafTriangles(const MergeInput& input) : in(input)
   {
-    leaf_triangles = detail::buildIncidence(
+    detail::buildBuckets<LeafTriangle>(
         in.triangles->size(),
         in.leaf_normals->size(),
         [&](std::size_t t, auto f) {
           const auto leaves = leavesOf(static_cast<pcl::index_t>(t));
-          if (spansLeaves(leaves))
-            forEachDistinct(leaves, f);
+          if (spansLeaves(leaves)) {
+            const LeafTriangle entry{leaves, static_cast<pcl::index_t>(t)};
+            forEachDistinct(leaves, [&](pcl::index_t l) { f(l, entry); });
+          }
         },
-        in.num_threads > 0 ? in.num_threads : static_cast<int>(defaultThreads()));
+        in.num_threads > 0 ? in.num_threads : static_cast<int>(defaultThreads()),
+        offsets,
+        entries);
   }
 
   /** The leaves of a triangle's vertices (-1: none). */
@@ -156,19 +169,19 @@ private:
     queue_.assign(1, seed);
     for (std::size_t head = 0; head < queue_.size(); ++head) {
       const auto leaf = queue_[head];
-      const auto& inc = adjacency_.leaf_triangles;
-      for (auto i = inc.offsets[leaf]; i < inc.offsets[leaf + 1]; ++i)
-        visitTriangle(inc.items[i], k, segment, leaf_segment);
+      for (auto i = adjacency_.offsets[leaf]; i < adjacency_.offsets[leaf + 1]; ++i)
+        visitTriangle(adjacency_.entries[i], k, segment, leaf_segment);
     }
     return segment.normal;
   }
 
-  void visitTriangle(pcl::index_t t,
+  void visitTriangle(const LeafTriangle& entry,
                      pcl::index_t k,
                      GrowingSegment& segment,
                      std::vector<pcl::index_t>& leaf_segment)
   {
-    const auto leaves = adjacency_.leavesOf(t);
+    const auto& leaves = entry.leaves;
+    const pcl::index_t t = entry.triangle;
     const bool edge = std::any_of(leaves.begin(), leaves.end(), [&](pcl::index_t l) {
       return l >= 0 && leaf_segment[l] != k;
     });
