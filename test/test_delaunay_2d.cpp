@@ -508,8 +508,21 @@ sweepMatchesBoost(const Points& points)
 {
   const Triangles boost = triangulate(points, DelaunayBackend::BoostVoronoi);
   const Triangles sweep = triangulate(points, DelaunayBackend::Sweep);
-  if (sweep == boost)
+  if (sweep == boost) {
+    // The adjacency each backend gives with its triangles (the sweep's read off its
+    // half-edges, across re-fanned co-circular groups) is the computed one.
+    Triangles expected;
+    computeTriangleNeighbours(boost, points.size(), expected);
+    for (const auto backend : {DelaunayBackend::Sweep, DelaunayBackend::BoostVoronoi}) {
+      Triangles triangles, neighbours;
+      if (!pcl::selective_seg::delaunay2d(points, backend, triangles, neighbours) ||
+          triangles != boost || neighbours != expected)
+        return ::testing::AssertionFailure()
+               << points.size() << " points: the adjacency given by backend "
+               << pcl::selective_seg::toString(backend) << " differs";
+    }
     return ::testing::AssertionSuccess();
+  }
   const auto differ =
       std::mismatch(boost.begin(), boost.end(), sweep.begin(), sweep.end());
   return ::testing::AssertionFailure()

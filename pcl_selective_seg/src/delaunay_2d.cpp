@@ -71,40 +71,94 @@ allCollinear(const std::vector<QuantizedPoint>& points)
 }
 
 void
-canonicalize(std::vector<Triangle>& triangles, std::size_t num_points)
+canonicalize(std::vector<Triangle>& triangles,
+             std::size_t num_points,
+             std::vector<Triangle>* neighbours,
+             int num_threads)
 {
-  // A counting sort on the first id, then a sort of each bucket (the few triangles
-  // whose smallest vertex is the same) on the other two. A triangulation of at most
-  // 2^31 points has fewer than 2^32 triangles: 32-bit offsets suffice.
-  std::vector<std::uint32_t> ends(num_points + 1, 0);
-  for (auto& t : triangles) {
-    if (t[1] < t[0] && t[1] < t[2])
-      t = {t[1], t[2], t[0]};
-    else if (t[2] < t[0] && t[2] < t[1])
-      t = {t[2], t[0], t[1]};
-    ++ends[t[0] + 1];
+  const auto num_slots = static_cast<std::ptrdiff_t>(triangles.size());
+  const int threads = std::max(1, num_threads);
+  const bool parallel = threads > 1 && num_slots >= 65536;
+  // Each triangle rotated so that its smallest id comes first; rotating the corners
+  // rotates the neighbours opposite them the same way. Removed slots stay as they are.
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(threads) schedule(static) if (parallel)
+#endif
+  for (std::ptrdiff_t t = 0; t < num_slots; ++t) {
+    Triangle& tri = triangles[t];
+    int first = 0;
+    if (tri[1] < tri[0] && tri[1] < tri[2])
+      first = 1;
+    else if (tri[2] < tri[0] && tri[2] < tri[1])
+      first = 2;
+    if (first == 0 || tri[0] == kNone)
+      continue;
+    std::rotate(tri.begin(), tri.begin() + first, tri.end());
+    if (neighbours)
+      std::rotate((*neighbours)[t].begin(), (*neighbours)[t].begin() + first, (*neighbours)[t].end());
   }
-  std::partial_sum(ends.begin(), ends.end(), ends.begin());
-  std::vector<Triangle> sorted(triangles.size());
-  for (const auto& t : triangles)
-    sorted[ends[t[0]]++] = t;
-  // Each ends[v] has moved from the start of bucket v to its end.
-  const auto later = [](const Triangle& s, const Triangle& t) {
-    return s[1] > t[1] || (s[1] == t[1] && s[2] > t[2]);
+  // order: the triangles bucketed by their first id (a counting sort), each bucket in
+  // increasing slot order; then each bucket (the few triangles sharing their smallest
+  // vertex) sorted on the other two ids.
+  std::vector<std::size_t> offsets;
+  std::vector<index_t> order;
+  detail::buildBuckets<index_t>(
+      triangles.size(),
+      num_points,
+      [&](std::size_t t, auto f) {
+        if (triangles[t][0] != kNone)
+          f(triangles[t][0], static_cast<index_t>(t));
+      },
+      parallel ? threads : 1,
+      offsets,
+      order);
+  const auto earlier = [&](index_t a, index_t b) {
+    const Triangle &s = triangles[a], &t = triangles[b];
+    return s[1] < t[1] || (s[1] == t[1] && s[2] < t[2]);
   };
-  std::size_t begin = 0;
-  for (std::size_t v = 0; v < num_points; ++v) {
-    const auto first = sorted.begin() + begin, last = sorted.begin() + ends[v];
+  const auto num_buckets = static_cast<std::ptrdiff_t>(num_points);
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(threads) schedule(static) if (parallel)
+#endif
+  for (std::ptrdiff_t v = 0; v < num_buckets; ++v) {
+    const auto first = order.begin() + static_cast<std::ptrdiff_t>(offsets[v]);
+    const auto last = order.begin() + static_cast<std::ptrdiff_t>(offsets[v + 1]);
     if (last - first > 16) {
-      std::sort(first, last);
+      std::sort(first, last, earlier);
     } else {
       for (auto i = first + 1; i < last; ++i)
-        for (auto j = i; j > first && later(*(j - 1), *j); --j)
+        for (auto j = i; j > first && earlier(*j, *(j - 1)); --j)
           std::iter_swap(j, j - 1);
     }
-    begin = ends[v];
   }
+  offsets = std::vector<std::size_t>();
+  const auto num_triangles = static_cast<std::ptrdiff_t>(order.size());
+  std::vector<Triangle> sorted(order.size());
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(threads) schedule(static) if (parallel)
+#endif
+  for (std::ptrdiff_t k = 0; k < num_triangles; ++k)
+    sorted[k] = triangles[order[k]];
   triangles.swap(sorted);
+  if (!neighbours)
+    return;
+  // The neighbours' new numbers, then the rows in the new order.
+  std::vector<index_t> position_of(static_cast<std::size_t>(num_slots));
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(threads) schedule(static) if (parallel)
+#endif
+  for (std::ptrdiff_t k = 0; k < num_triangles; ++k)
+    position_of[order[k]] = static_cast<index_t>(k);
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(threads) schedule(static) if (parallel)
+#endif
+  for (std::ptrdiff_t k = 0; k < num_triangles; ++k) {
+    const Triangle& old = (*neighbours)[order[k]];
+    for (int i = 0; i < 3; ++i)
+      sorted[k][i] = old[i] == kNone ? kNone : position_of[old[i]];
+  }
+  sorted.resize(order.size());
+  neighbours->swap(sorted);
 }
 
 void
@@ -573,7 +627,7 @@ runBackend(const std::vector<QuantizedPoint>& points,
   case DelaunayBackend::BoostVoronoi:
     return detail::delaunayBoostVoronoi(points, triangles, error);
   case DelaunayBackend::Sweep:
-    return detail::delaunaySweep(points, triangles, error);
+    return detail::delaunaySweep(points, triangles, nullptr, error);
   case DelaunayBackend::Vtk:
 #ifdef PCL_SELSEG_HAVE_VTK
     return detail::delaunayVtk(points, triangles, error);
@@ -620,13 +674,19 @@ isDelaunayBackendAvailable(DelaunayBackend backend)
   return false;
 }
 
+namespace {
+
 bool
-delaunay2d(const std::vector<QuantizedPoint>& points,
-           DelaunayBackend backend,
-           std::vector<Triangle>& triangles,
-           std::string* error)
+triangulate2d(const std::vector<QuantizedPoint>& points,
+              DelaunayBackend backend,
+              std::vector<Triangle>& triangles,
+              std::vector<Triangle>* neighbours,
+              std::string* error,
+              unsigned int num_threads)
 {
   triangles.clear();
+  if (neighbours)
+    neighbours->clear();
   if (!isDelaunayBackendAvailable(backend)) {
     setError(error,
              std::string("delaunay2d: backend '") + toString(backend) +
@@ -637,9 +697,10 @@ delaunay2d(const std::vector<QuantizedPoint>& points,
   if (!checkRange(points, error))
     return false;
   // The sweep sorts the points anyway, which finds duplicates at no extra cost; it
-  // also returns its triangles in canonical order.
+  // also returns its triangles in canonical order, and its adjacency.
   if (backend == DelaunayBackend::Sweep)
-    return detail::delaunaySweep(points, triangles, error);
+    return detail::delaunaySweep(
+        points, triangles, neighbours, error, static_cast<int>(num_threads));
   if (!checkDistinct(points, error))
     return false;
   if (points.size() < 3 || detail::allCollinear(points))
@@ -649,7 +710,31 @@ delaunay2d(const std::vector<QuantizedPoint>& points,
     return false;
   }
   detail::canonicalize(triangles, points.size());
+  if (neighbours)
+    computeTriangleNeighbours(triangles, points.size(), *neighbours, num_threads);
   return true;
+}
+
+} // namespace
+
+bool
+delaunay2d(const std::vector<QuantizedPoint>& points,
+           DelaunayBackend backend,
+           std::vector<Triangle>& triangles,
+           std::string* error)
+{
+  return triangulate2d(points, backend, triangles, nullptr, error, 1);
+}
+
+bool
+delaunay2d(const std::vector<QuantizedPoint>& points,
+           DelaunayBackend backend,
+           std::vector<Triangle>& triangles,
+           std::vector<Triangle>& neighbours,
+           std::string* error,
+           unsigned int num_threads)
+{
+  return triangulate2d(points, backend, triangles, &neighbours, error, num_threads);
 }
 
 void

@@ -19,6 +19,9 @@ namespace pcl {
 namespace selective_seg {
 namespace detail {
 
+/** \brief No vertex, triangle or half-edge (removed slots, boundary neighbours). */
+constexpr index_t kNone = -1;
+
 /** \brief Signed 128-bit integer (a GCC/Clang extension, hence the marker). */
 __extension__ typedef __int128 Int128;
 
@@ -82,8 +85,15 @@ void reportDuplicate(const std::vector<QuantizedPoint>& points,
 bool allCollinear(const std::vector<QuantizedPoint>& points);
 
 /** \brief Rotates each triangle so that its smallest id comes first, then sorts the
- * list (linear time: a counting sort on the first id, then small buckets). */
-void canonicalize(std::vector<Triangle>& triangles, std::size_t num_points);
+ * list (linear time: a counting sort on the first id, then small buckets). Slots whose
+ * first corner is kNone (removed triangles) are dropped. With \a neighbours (the
+ * adjacency of the slots as given, in computeTriangleNeighbours()'s layout, never
+ * naming a removed slot), the adjacency is carried along: rows rotated and reordered,
+ * triangle numbers renamed. The result does not depend on \a num_threads. */
+void canonicalize(std::vector<Triangle>& triangles,
+                  std::size_t num_points,
+                  std::vector<Triangle>* neighbours = nullptr,
+                  int num_threads = 1);
 
 /** \brief Replaces the triangles of one co-circular group (a triangulated convex
  * polygon, \a group its triangle indices) by the fan from the polygon's
@@ -113,11 +123,15 @@ bool delaunayBoostVoronoi(const std::vector<QuantizedPoint>& points,
  * points (same error as delaunay2d()), returns no triangles for fewer than three or
  * collinear points, and lists the triangles in canonical order. On inputs where the
  * sweep order is a bad insertion order (points along concave curves) it gives up after
- * a budget of flips and returns delaunayBoostVoronoi()'s triangles.
+ * a budget of flips and returns delaunayBoostVoronoi()'s triangles. With \a neighbours
+ * it also gives the adjacency (computeTriangleNeighbours()'s result), read off the
+ * sweep's half-edges.
  */
 bool delaunaySweep(const std::vector<QuantizedPoint>& points,
                    std::vector<Triangle>& triangles,
-                   std::string* error);
+                   std::vector<Triangle>* neighbours,
+                   std::string* error,
+                   int num_threads = 1);
 
 /** \brief Triangulation by vtkDelaunay2D (floating point), triangles oriented counter-
  * clockwise by the exact orientation, degenerate ones dropped, not in canonical order.

@@ -29,9 +29,8 @@ namespace {
 
 using detail::inCircle;
 using detail::Int128;
+using detail::kNone;
 using detail::orientation;
-
-constexpr index_t kNone = -1;
 
 // ------------------------------------------------------------------ the order
 
@@ -200,6 +199,17 @@ public:
    * circumcircle (valid after repairAndClassify()). */
   bool isOnCircle(index_t e) const { return circle_[e] == kOnCircle; }
 
+  /** Splits one co-circular group (its triangles' slots) by the canonical fan
+   * (detail::refanGroup()) and relinks the twins of its half-edges and of the
+   * half-edges across its boundary, so that the half-edge structure stays valid.
+   * False if the fan's polygon edges are not the group's (an internal error). */
+  bool refan(const std::vector<QuantizedPoint>& points, const std::vector<index_t>& group);
+
+  /** The adjacency of the live triangles in computeTriangleNeighbours()'s layout
+   * (neighbour i across the edge opposite corner i, -1 on the boundary), one row per
+   * slot; rows of removed triangles are left -1. */
+  void neighbours(std::vector<Triangle>& out) const;
+
 private:
   /** What the last in-circle test of an edge found, while its two triangles remain. */
   enum CircleState : char { kUntested = 0, kOffCircle, kOnCircle };
@@ -258,6 +268,14 @@ private:
   int bucket_shift_ = 0;
   std::vector<index_t> stack_;
   std::int64_t flips_ = 0, flip_budget_ = 0;
+  /** refan() scratch: the polygon's corners, and its boundary half-edges as
+   * (origin, destination, twin across, circle state). */
+  struct BoundaryEdge {
+    index_t from, to, twin;
+    CircleState circle;
+  };
+  std::vector<index_t> corners_;
+  std::vector<BoundaryEdge> boundary_;
 };
 
 SweepTriangulation::SweepTriangulation(const std::vector<QuantizedPoint>& points)
@@ -684,14 +702,74 @@ SweepTriangulation::repairAndClassify()
   return !overBudget();
 }
 
-/** Splits every group of co-circular triangles (joined across marked edges: the
- * triangulation of one empty circle's polygon) by the canonical fan, in place. */
+bool
+SweepTriangulation::refan(const std::vector<QuantizedPoint>& points,
+                          const std::vector<index_t>& group)
+{
+  // The group's boundary half-edges: the polygon's edges, counter-clockwise, which the
+  // fan keeps (an edge between two triangles of the group is on their common circle).
+  boundary_.clear();
+  for (const index_t g : group)
+    for (index_t e = 4 * g; e < 4 * g + 3; ++e)
+      if (!isOnCircle(e))
+        boundary_.push_back({origin(e), origin(nextEdge(e)), twins_[e], circle_[e]});
+  const auto by_ends = [](const BoundaryEdge& a, const BoundaryEdge& b) {
+    return a.from < b.from || (a.from == b.from && a.to < b.to);
+  };
+  std::sort(boundary_.begin(), boundary_.end(), by_ends);
+  detail::refanGroup(points, group, triangles_, corners_);
+  // Fan triangle s is (c0, c[s + 1], c[s + 2]) in slot group[s]: its edge c[s + 2] -> c0
+  // (corner 2) is the twin of the next one's c0 -> c[s + 2] (corner 0); the others lie
+  // on the polygon.
+  for (std::size_t s = 0; s < group.size(); ++s) {
+    const index_t first = 4 * group[s];
+    for (index_t e = first; e < first + 3; ++e) {
+      if ((e == first && s > 0) || (e == first + 2 && s + 1 < group.size())) {
+        const index_t partner = e == first ? 4 * group[s - 1] + 2 : 4 * group[s + 1];
+        twins_[e] = partner;
+        circle_[e] = kOnCircle;
+        continue;
+      }
+      const BoundaryEdge key{origin(e), origin(nextEdge(e)), kNone, kUntested};
+      const auto found =
+          std::lower_bound(boundary_.begin(), boundary_.end(), key, by_ends);
+      if (found == boundary_.end() || found->from != key.from || found->to != key.to)
+        return false;
+      twins_[e] = found->twin;
+      circle_[e] = found->circle;
+      if (found->twin != kNone)
+        twins_[found->twin] = e;
+      else
+        boundary_edge_[key.from] = e;
+    }
+  }
+  return true;
+}
+
 void
+SweepTriangulation::neighbours(std::vector<Triangle>& out) const
+{
+  out.assign(triangles_.size(), Triangle{kNone, kNone, kNone});
+  for (index_t t = 0; t < static_cast<index_t>(triangles_.size()); ++t) {
+    if (triangles_[t][0] == kNone)
+      continue;
+    // The edge opposite corner i is half-edge i + 1 (from corner i + 1 to i + 2).
+    for (int i = 0; i < 3; ++i) {
+      const index_t twin = twins_[4 * t + (i + 1) % 3];
+      out[t][i] = twin == kNone ? kNone : triangleOf(twin);
+    }
+  }
+}
+
+/** Splits every group of co-circular triangles (joined across marked edges: the
+ * triangulation of one empty circle's polygon) by the canonical fan, in place. False
+ * on an internal error (SweepTriangulation::refan()). */
+bool
 refanCoCircular(const std::vector<QuantizedPoint>& points, SweepTriangulation& mesh)
 {
   std::vector<Triangle>& triangles = mesh.triangles();
   std::vector<char> visited(triangles.size(), 0);
-  std::vector<index_t> group, pending, corners;
+  std::vector<index_t> group, pending;
   const auto on_circle = [&](index_t t) {
     return mesh.isOnCircle(4 * t) || mesh.isOnCircle(4 * t + 1) ||
            mesh.isOnCircle(4 * t + 2);
@@ -714,26 +792,30 @@ refanCoCircular(const std::vector<QuantizedPoint>& points, SweepTriangulation& m
         }
       }
     }
-    detail::refanGroup(points, group, triangles, corners);
+    if (!mesh.refan(points, group))
+      return false;
   }
+  return true;
 }
 
 /** The Delaunay triangulation of distinct points sorted lexicographically, not all
- * collinear, with the canonical fans, in the points' ids (not in canonical order).
+ * collinear, with the canonical fans, in the points' ids, by slot: removed slots hold
+ * kNone corners (detail::canonicalize() drops them). Optionally its adjacency
+ * (computeTriangleNeighbours()'s layout, by slot), read off the sweep's half-edges.
  * False if the sweep ran out of budget (SweepTriangulation::build()). */
 bool
 triangulateSorted(const std::vector<QuantizedPoint>& points,
-                  std::vector<Triangle>& triangles)
+                  std::vector<Triangle>& triangles,
+                  std::vector<Triangle>* neighbours)
 {
   SweepTriangulation mesh(points);
   if (!mesh.build())
     return false;
-  refanCoCircular(points, mesh);
+  if (!refanCoCircular(points, mesh))
+    return false;
+  if (neighbours)
+    mesh.neighbours(*neighbours);
   triangles.swap(mesh.triangles());
-  triangles.erase(std::remove_if(triangles.begin(),
-                                 triangles.end(),
-                                 [](const Triangle& t) { return t[0] == kNone; }),
-                  triangles.end());
   return true;
 }
 
@@ -742,11 +824,14 @@ triangulateSorted(const std::vector<QuantizedPoint>& points,
 bool
 triangulateByBoost(const std::vector<QuantizedPoint>& points,
                    std::vector<Triangle>& triangles,
+                   std::vector<Triangle>* neighbours,
                    std::string* error)
 {
   if (!detail::delaunayBoostVoronoi(points, triangles, error))
     return false;
   detail::canonicalize(triangles, points.size());
+  if (neighbours)
+    computeTriangleNeighbours(triangles, points.size(), *neighbours);
   return true;
 }
 
@@ -757,15 +842,19 @@ namespace detail {
 bool
 delaunaySweep(const std::vector<QuantizedPoint>& points,
               std::vector<Triangle>& triangles,
-              std::string* error)
+              std::vector<Triangle>* neighbours,
+              std::string* error,
+              int num_threads)
 {
   triangles.clear();
+  if (neighbours)
+    neighbours->clear();
   if (isStrictlySorted(points)) {
     if (points.size() < 3 || allCollinear(points))
       return true;
-    if (!triangulateSorted(points, triangles))
-      return triangulateByBoost(points, triangles, error);
-    canonicalize(triangles, points.size());
+    if (!triangulateSorted(points, triangles, neighbours))
+      return triangulateByBoost(points, triangles, neighbours, error);
+    canonicalize(triangles, points.size(), neighbours, num_threads);
     return true;
   }
   std::vector<std::uint64_t> keys;
@@ -780,12 +869,13 @@ delaunaySweep(const std::vector<QuantizedPoint>& points,
     sorted[i] = points[order[i]];
   if (points.size() < 3 || allCollinear(sorted))
     return true;
-  if (!triangulateSorted(sorted, triangles))
-    return triangulateByBoost(points, triangles, error);
+  if (!triangulateSorted(sorted, triangles, neighbours))
+    return triangulateByBoost(points, triangles, neighbours, error);
   for (auto& t : triangles)
-    for (auto& v : t)
-      v = order[v];
-  canonicalize(triangles, points.size());
+    if (t[0] != kNone)
+      for (auto& v : t)
+        v = order[v];
+  canonicalize(triangles, points.size(), neighbours, num_threads);
   return true;
 }
 

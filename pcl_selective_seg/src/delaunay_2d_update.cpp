@@ -297,9 +297,8 @@ Inserter::run(const std::vector<QuantizedPoint>& q,
   for (std::size_t i = 0; i < local.size(); ++i)
     local_points[i] = out_points[local[i]];
   std::vector<Triangle> local_tris, local_nbrs;
-  if (!detail::delaunaySweep(local_points, local_tris, error))
+  if (!detail::delaunaySweep(local_points, local_tris, &local_nbrs, error))
     return false;
-  computeTriangleNeighbours(local_tris, local.size(), local_nbrs);
   std::vector<std::uint8_t> is_new_point(local.size(), 0);
   for (std::size_t i = 0, j = 0; i < local.size(); ++i) {
     while (j < info.inserted_points.size() && info.inserted_points[j] < local[i])

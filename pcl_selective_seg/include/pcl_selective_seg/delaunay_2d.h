@@ -86,6 +86,17 @@ PCL_EXPORTS bool delaunay2d(const std::vector<QuantizedPoint>& points,
                             std::vector<Triangle>& triangles,
                             std::string* error = nullptr);
 
+/** \brief delaunay2d() with the triangle adjacency (computeTriangleNeighbours()'s
+ * result, \a neighbours). The Sweep backend reads it off its own half-edges, which
+ * costs a fraction of computing it afterwards; the other backends compute it (with \a
+ * num_threads threads). */
+PCL_EXPORTS bool delaunay2d(const std::vector<QuantizedPoint>& points,
+                            DelaunayBackend backend,
+                            std::vector<Triangle>& triangles,
+                            std::vector<Triangle>& neighbours,
+                            std::string* error = nullptr,
+                            unsigned int num_threads = 1);
+
 /** \brief Triangle adjacency of a triangle mesh.
  *
  * \param[in] triangles triangles over vertex ids 0..num_vertices-1, consistently

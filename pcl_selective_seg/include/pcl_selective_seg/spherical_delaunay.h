@@ -94,6 +94,14 @@ public:
   void setComputeNeighbours(bool compute) { compute_neighbours_ = compute; }
   bool getComputeNeighbours() const { return compute_neighbours_; }
 
+  /** \brief Moves SphericalTriangulation::neighbours into \a neighbours, leaving the
+   * triangulation's list empty (for a caller that keeps the adjacency elsewhere). */
+  void takeNeighbours(std::vector<Triangle>& neighbours)
+  {
+    neighbours.swap(triangulation_.neighbours);
+    triangulation_.neighbours.clear();
+  }
+
   /** \brief Grid step of the angle quantization [rad], in [2.5e-8, 1e-2]. */
   void setAngleQuantization(double step) { angle_quantization_ = step; }
   double getAngleQuantization() const { return angle_quantization_; }

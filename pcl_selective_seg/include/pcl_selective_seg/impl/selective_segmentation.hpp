@@ -88,8 +88,13 @@ SelectiveSegmentation<PointT>::triangulate()
   delaunay_.setBackend(params_.delaunay_backend);
   delaunay_.setAngleQuantization(params_.angle_quantization);
   delaunay_.setNumberOfThreads(static_cast<unsigned int>(params_.num_threads));
-  delaunay_.setComputeNeighbours(false); // computed once, into the result below
-  if (!delaunay_.triangulate())
+  // The adjacency comes with the triangles (the sweep reads it off its half-edges) and
+  // moves into the result; update() keeps it there, not in the triangulation.
+  delaunay_.setComputeNeighbours(true);
+  const bool triangulated = delaunay_.triangulate();
+  delaunay_.takeNeighbours(result_.mesh.neighbours);
+  delaunay_.setComputeNeighbours(false);
+  if (!triangulated)
     return fail("extract", "the spherical triangulation failed (reason above)");
   const SphericalTriangulation& tri = delaunay_.getTriangulation();
   takeTriangulationCounts();
@@ -140,10 +145,6 @@ SelectiveSegmentation<PointT>::triangulate()
                 "the " + std::to_string(pos.size()) +
                     " distinct points lie on one line in 3-D (to float precision): "
                     "there is no surface to segment");
-  computeTriangleNeighbours(tri.triangles,
-                            tri.vertex_point.size(),
-                            result_.mesh.neighbours,
-                            static_cast<unsigned int>(numThreads()));
   return true;
 }
 

@@ -232,19 +232,21 @@ bool
 SphericalDelaunay<PointT>::triangulateVertices()
 {
   std::string why;
-  if (!delaunay2d(
-          triangulation_.vertex_angles, backend_, triangulation_.triangles, &why)) {
+  const bool ok =
+      compute_neighbours_
+          ? delaunay2d(triangulation_.vertex_angles,
+                       backend_,
+                       triangulation_.triangles,
+                       triangulation_.neighbours,
+                       &why,
+                       num_threads_)
+          : delaunay2d(
+                triangulation_.vertex_angles, backend_, triangulation_.triangles, &why);
+  if (!ok)
     PCL_ERROR("[pcl::selective_seg::%s::triangulate] %s\n",
               getClassName().c_str(),
               why.c_str());
-    return false;
-  }
-  if (compute_neighbours_)
-    computeTriangleNeighbours(triangulation_.triangles,
-                              triangulation_.vertex_angles.size(),
-                              triangulation_.neighbours,
-                              num_threads_);
-  return true;
+  return ok;
 }
 
 template <typename PointT>
