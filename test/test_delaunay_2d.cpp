@@ -513,14 +513,18 @@ sweepMatchesBoost(const Points& points)
     // half-edges, across re-fanned co-circular groups) is the computed one.
     Triangles expected;
     computeTriangleNeighbours(boost, points.size(), expected);
-    for (const auto backend : {DelaunayBackend::Sweep, DelaunayBackend::BoostVoronoi}) {
-      Triangles triangles, neighbours;
-      if (!pcl::selective_seg::delaunay2d(points, backend, triangles, neighbours) ||
-          triangles != boost || neighbours != expected)
-        return ::testing::AssertionFailure()
-               << points.size() << " points: the adjacency given by backend "
-               << pcl::selective_seg::toString(backend) << " differs";
-    }
+    // Large inputs take the parallel paths: the same result for 1 and 2 threads.
+    for (const auto backend : {DelaunayBackend::Sweep, DelaunayBackend::BoostVoronoi})
+      for (const unsigned int threads : {1u, 2u}) {
+        Triangles triangles, neighbours;
+        if (!pcl::selective_seg::delaunay2d(
+                points, backend, triangles, neighbours, nullptr, threads) ||
+            triangles != boost || neighbours != expected)
+          return ::testing::AssertionFailure()
+                 << points.size() << " points: the triangles or adjacency given by "
+                 << pcl::selective_seg::toString(backend) << " with " << threads
+                 << " threads differ";
+      }
     return ::testing::AssertionSuccess();
   }
   const auto differ =

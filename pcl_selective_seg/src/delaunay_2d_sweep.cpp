@@ -20,6 +20,10 @@
 #include <memory>
 #include <vector>
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 #include "delaunay_2d_backends.h"
 
 namespace pcl {
@@ -177,7 +181,9 @@ isSharpNotch(const QuantizedPoint& a, const QuantizedPoint& b, const QuantizedPo
  */
 class SweepTriangulation {
 public:
-  explicit SweepTriangulation(const std::vector<QuantizedPoint>& points);
+  /** \a num_threads: threads of the final classification pass (the result does not
+   * depend on it); the sweep itself is sequential. */
+  SweepTriangulation(const std::vector<QuantizedPoint>& points, int num_threads = 1);
 
   /** Sweeps, completes the convex hull, removes the artificial points, then repairs and
    * classifies every edge (repairAndClassify()). Returns false, unfinished, if that
@@ -268,6 +274,7 @@ private:
   int bucket_shift_ = 0;
   std::vector<index_t> stack_;
   std::int64_t flips_ = 0, flip_budget_ = 0;
+  int num_threads_ = 1;
   /** refan() scratch: the polygon's corners, and its boundary half-edges as
    * (origin, destination, twin across, circle state). */
   struct BoundaryEdge {
@@ -278,8 +285,9 @@ private:
   std::vector<BoundaryEdge> boundary_;
 };
 
-SweepTriangulation::SweepTriangulation(const std::vector<QuantizedPoint>& points)
-    : points_(points)
+SweepTriangulation::SweepTriangulation(const std::vector<QuantizedPoint>& points,
+                                       int num_threads)
+    : points_(points), num_threads_(std::max(1, num_threads))
 {
   const auto n = static_cast<index_t>(points.size());
   points_.reserve(points.size() + 2);
@@ -682,13 +690,32 @@ bool
 SweepTriangulation::repairAndClassify()
 {
   std::vector<index_t>& illegal = stack_;
-  for (index_t t = 0; t < static_cast<index_t>(triangles_.size()); ++t) {
-    if (triangles_[t][0] == kNone)
-      continue;
-    for (index_t e = 4 * t; e < 4 * t + 3; ++e)
-      if (circle_[e] == kUntested && twins_[e] > e && classify(e) > 0)
-        illegal.push_back(e);
+  // Every interior edge not yet classified, tested once from its lower half-edge (which
+  // alone reads and writes the pair's states, so the triangles can be split among
+  // threads); the illegal ones listed in increasing order, whatever the thread count.
+  const auto num_triangles = static_cast<index_t>(triangles_.size());
+  const int threads = num_triangles >= 65536 ? num_threads_ : 1;
+  std::vector<std::vector<index_t>> found(static_cast<std::size_t>(threads));
+#ifdef _OPENMP
+#pragma omp parallel num_threads(threads)
+#endif
+  {
+#ifdef _OPENMP
+    std::vector<index_t>& mine = found[static_cast<std::size_t>(omp_get_thread_num())];
+#pragma omp for schedule(static)
+#else
+    std::vector<index_t>& mine = found[0];
+#endif
+    for (index_t t = 0; t < num_triangles; ++t) {
+      if (triangles_[t][0] == kNone)
+        continue;
+      for (index_t e = 4 * t; e < 4 * t + 3; ++e)
+        if (twins_[e] > e && circle_[e] == kUntested && classify(e) > 0)
+          mine.push_back(e);
+    }
   }
+  for (const auto& part : found)
+    illegal.insert(illegal.end(), part.begin(), part.end());
   while (!illegal.empty() && !overBudget()) {
     const index_t e = illegal.back();
     illegal.pop_back();
@@ -806,9 +833,10 @@ refanCoCircular(const std::vector<QuantizedPoint>& points, SweepTriangulation& m
 bool
 triangulateSorted(const std::vector<QuantizedPoint>& points,
                   std::vector<Triangle>& triangles,
-                  std::vector<Triangle>* neighbours)
+                  std::vector<Triangle>* neighbours,
+                  int num_threads)
 {
-  SweepTriangulation mesh(points);
+  SweepTriangulation mesh(points, num_threads);
   if (!mesh.build())
     return false;
   if (!refanCoCircular(points, mesh))
@@ -852,7 +880,7 @@ delaunaySweep(const std::vector<QuantizedPoint>& points,
   if (isStrictlySorted(points)) {
     if (points.size() < 3 || allCollinear(points))
       return true;
-    if (!triangulateSorted(points, triangles, neighbours))
+    if (!triangulateSorted(points, triangles, neighbours, num_threads))
       return triangulateByBoost(points, triangles, neighbours, error);
     canonicalize(triangles, points.size(), neighbours, num_threads);
     return true;
@@ -869,7 +897,7 @@ delaunaySweep(const std::vector<QuantizedPoint>& points,
     sorted[i] = points[order[i]];
   if (points.size() < 3 || allCollinear(sorted))
     return true;
-  if (!triangulateSorted(sorted, triangles, neighbours))
+  if (!triangulateSorted(sorted, triangles, neighbours, num_threads))
     return triangulateByBoost(points, triangles, neighbours, error);
   for (auto& t : triangles)
     if (t[0] != kNone)
