@@ -6,12 +6,14 @@
  *  Unit tests of the triangle and point normals (paper, Sec. III.B, eq. 2-3).
  */
 
+#include <pcl_selective_seg/delaunay_2d.h>
 #include <pcl_selective_seg/mesh_normals.h>
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <random>
 #include <vector>
@@ -491,6 +493,59 @@ TEST(MeshNormals, MedianEdgeLengthIsTheSampledEdgesMedianForAnyThreadCount)
     for (const int threads : {1, 2, 3})
       EXPECT_EQ(medianEdgeLength(positions, triangles, threads), expected)
           << num_triangles << " triangles, " << threads << " threads";
+  }
+}
+
+TEST(MeshNormals, ScatteredSumsEqualTheGatheredOnesToTheBit)
+{
+  // With the adjacency and canonical order of delaunay2d(), computeVertexNormals() adds
+  // each triangle's terms to its vertices in one pass (split among threads, vertices
+  // reached by two runs redone over their stars); the gathered sums are the reference.
+  std::mt19937 rng(11);
+  for (const int n : {50, 3000, 60000}) {
+    std::vector<pcl::selective_seg::QuantizedPoint> angles;
+    std::uniform_int_distribution<std::int32_t> coordinate(0, 4 * n);
+    while (angles.size() < static_cast<std::size_t>(n))
+      angles.push_back({coordinate(rng), coordinate(rng)});
+    std::sort(angles.begin(), angles.end());
+    angles.erase(std::unique(angles.begin(), angles.end()), angles.end());
+    Vector3fVector positions;
+    std::normal_distribution<float> noise(0.f, 0.2f);
+    for (const auto& a : angles)
+      positions.emplace_back(a[0] * 1e-3f, a[1] * 1e-3f, 1.f + noise(rng));
+    for (std::size_t i = 7; i < positions.size(); i += 97)
+      positions[i] = positions[i - 1]; // zero-area triangles
+    std::vector<Triangle> triangles, neighbours;
+    ASSERT_TRUE(pcl::selective_seg::delaunay2d(angles,
+                                               pcl::selective_seg::DelaunayBackend::Sweep,
+                                               triangles,
+                                               neighbours));
+    Vector3fVector normals;
+    std::vector<double> areas;
+    computeTriangleNormals(positions, triangles, Eigen::Vector3f::Zero(), normals, areas);
+    Vector3fVector gathered;
+    std::vector<double> gathered_areas;
+    computeVertexNormals(
+        positions.size(), triangles, normals, areas, gathered, gathered_areas, 1);
+    for (const int threads : {1, 2, 3}) {
+      Vector3fVector scattered;
+      std::vector<double> scattered_areas;
+      computeVertexNormals(positions.size(),
+                           triangles,
+                           normals,
+                           areas,
+                           scattered,
+                           scattered_areas,
+                           threads,
+                           &neighbours);
+      ASSERT_EQ(scattered.size(), gathered.size());
+      EXPECT_EQ(std::memcmp(scattered.data(),
+                            gathered.data(),
+                            gathered.size() * sizeof(Eigen::Vector3f)),
+                0)
+          << n << " points, " << threads << " threads";
+      EXPECT_EQ(scattered_areas, gathered_areas) << n << " points, " << threads;
+    }
   }
 }
 

@@ -159,6 +159,102 @@ computeTriangleNormalsAndEdgeOn(const Vector3fVector& positions,
   }
 }
 
+namespace {
+
+/** Smallest vertex of a triangle. */
+inline pcl::index_t
+lowestVertex(const Triangle& t)
+{
+  return std::min(t[0], std::min(t[1], t[2]));
+}
+
+void
+starOf(pcl::index_t v,
+       pcl::index_t first,
+       const std::vector<Triangle>& triangles,
+       const std::vector<Triangle>& neighbours,
+       std::vector<pcl::index_t>& star);
+
+/** computeVertexNormals() for triangles listed by non-decreasing smallest vertex, with
+ * their adjacency: each thread takes a run of triangles and adds their terms (eq. 2-3)
+ * straight to the vertices it alone reaches; a vertex that an earlier run also reaches
+ * is left for the end, when its sum is redone over its whole star, in increasing order.
+ *
+ * Run c starts at triangle b_c with smallest vertex m_c; its triangles' vertices are at
+ * least m_c and those of later runs at least m_(c+1), so run c adds directly to the
+ * vertices in [m_c, m_(c+1)), which no later run reaches, and defers the others. A
+ * vertex in [m_c, m_(c+1)) reached by an earlier run is deferred by that run. */
+void
+scatterVertexNormals(std::size_t num_vertices,
+                     const std::vector<Triangle>& triangles,
+                     const std::vector<Triangle>& neighbours,
+                     const Vector3fVector& normals,
+                     const std::vector<double>& areas,
+                     Vector3fVector& vertex_normals,
+                     std::vector<double>& vertex_areas,
+                     int num_threads)
+{
+  const std::size_t num_triangles = triangles.size();
+  const auto runs = static_cast<std::size_t>(
+      num_threads > 1 && num_triangles >= 65536 ? num_threads : 1);
+  std::vector<pcl::index_t> run_lowest(runs + 1);
+  for (std::size_t c = 0; c < runs; ++c)
+    run_lowest[c] = lowestVertex(triangles[c * num_triangles / runs]);
+  run_lowest[runs] = static_cast<pcl::index_t>(num_vertices);
+  std::vector<Eigen::Vector3d> sums(num_vertices, Eigen::Vector3d::Zero());
+  vertex_areas.assign(num_vertices, 0.0);
+  std::vector<std::vector<std::pair<pcl::index_t, pcl::index_t>>> deferred(runs);
+#pragma omp parallel for num_threads(static_cast<int>(runs)) schedule(static, 1)
+  for (std::ptrdiff_t c = 0; c < static_cast<std::ptrdiff_t>(runs); ++c) {
+    const pcl::index_t upper = run_lowest[c + 1];
+    for (std::size_t t = c * num_triangles / runs; t < (c + 1) * num_triangles / runs;
+         ++t) {
+      const bool finite_area = std::isfinite(areas[t]);
+      const double weight = normalWeight(areas[t], normals[t]);
+      const Eigen::Vector3d term = weight * normals[t].cast<double>();
+      for (const auto v : triangles[t]) {
+        if (v >= upper) {
+          deferred[c].emplace_back(v, static_cast<pcl::index_t>(t));
+          continue;
+        }
+        if (finite_area)
+          vertex_areas[v] += areas[t];
+        if (weight > 0.0)
+          sums[v] += term;
+      }
+    }
+  }
+  vertex_normals.resize(num_vertices);
+#pragma omp parallel for num_threads(static_cast<int>(runs)) schedule(static)
+  for (std::ptrdiff_t v = 0; v < static_cast<std::ptrdiff_t>(num_vertices); ++v)
+    vertex_normals[v] = normalizedOrNaN(sums[v]);
+  // The deferred vertices, each once, over their stars.
+  std::vector<std::pair<pcl::index_t, pcl::index_t>> redo;
+  for (const auto& run : deferred)
+    redo.insert(redo.end(), run.begin(), run.end());
+  std::sort(redo.begin(), redo.end());
+  redo.erase(std::unique(redo.begin(),
+                         redo.end(),
+                         [](const auto& a, const auto& b) { return a.first == b.first; }),
+             redo.end());
+#pragma omp parallel num_threads(static_cast<int>(runs))
+  {
+    std::vector<pcl::index_t> star;
+#pragma omp for schedule(static)
+    for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(redo.size()); ++k) {
+      starOf(redo[k].first, redo[k].second, triangles, neighbours, star);
+      vertexNormal(star.data(),
+                   star.data() + star.size(),
+                   normals,
+                   areas,
+                   vertex_normals[redo[k].first],
+                   vertex_areas[redo[k].first]);
+    }
+  }
+}
+
+} // namespace
+
 void
 computeVertexNormals(std::size_t num_vertices,
                      const std::vector<Triangle>& triangles,
@@ -166,8 +262,23 @@ computeVertexNormals(std::size_t num_vertices,
                      const std::vector<double>& areas,
                      Vector3fVector& vertex_normals,
                      std::vector<double>& vertex_areas,
-                     int num_threads)
+                     int num_threads,
+                     const std::vector<Triangle>* neighbours)
 {
+  bool by_lowest_vertex = neighbours && neighbours->size() == triangles.size();
+  for (std::size_t t = 1; by_lowest_vertex && t < triangles.size(); ++t)
+    by_lowest_vertex = lowestVertex(triangles[t - 1]) <= lowestVertex(triangles[t]);
+  if (by_lowest_vertex) {
+    scatterVertexNormals(num_vertices,
+                         triangles,
+                         *neighbours,
+                         normals,
+                         areas,
+                         vertex_normals,
+                         vertex_areas,
+                         threads(num_threads));
+    return;
+  }
   // Gathered per vertex over its triangles in increasing order: the same sums, in the
   // same order, whatever the number of threads.
   const Incidence incident =

@@ -51,6 +51,12 @@ PCL_EXPORTS void computeTriangleNormals(const Vector3fVector& positions,
  * \param[out] vertex_areas #V areas A_p [m^2]
  * \param[in] num_threads OpenMP threads, 0 = all cores (the result does not depend on
  * it)
+ * \param[in] neighbours optional: the adjacency of \a triangles
+ *            (computeTriangleNeighbours()). When given and the triangles are listed by
+ *            non-decreasing smallest vertex (delaunay2d()'s canonical order), each
+ *            triangle's terms are added to its vertices in one pass over the triangles
+ *            instead of gathered through vertex -> triangle lists: the same sums in the
+ *            same order (increasing triangle index), so the same bits.
  */
 PCL_EXPORTS void computeVertexNormals(std::size_t num_vertices,
                                       const std::vector<Triangle>& triangles,
@@ -58,7 +64,8 @@ PCL_EXPORTS void computeVertexNormals(std::size_t num_vertices,
                                       const std::vector<double>& areas,
                                       Vector3fVector& vertex_normals,
                                       std::vector<double>& vertex_areas,
-                                      int num_threads = 0);
+                                      int num_threads = 0,
+                                      const std::vector<Triangle>* neighbours = nullptr);
 
 /** \brief Point normals over a wider neighbourhood: eq. 2 summed over the triangles of
  * the k-ring of each vertex instead of its one ring.

@@ -170,7 +170,8 @@ SelectiveSegmentation<PointT>::computeNormals()
                        triangle_areas_,
                        vertex_normals_,
                        *vertex_areas_,
-                       params_.num_threads);
+                       params_.num_threads,
+                       &result_.mesh.neighbours);
   if (params_.normal_rings > 1)
     computeVertexNormalsOverRings(positions.size(),
                                   tri.triangles,
