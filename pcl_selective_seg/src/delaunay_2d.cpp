@@ -93,9 +93,12 @@ canonicalize(std::vector<Triangle>& triangles,
       first = 2;
     if (first == 0 || tri[0] == kNone)
       continue;
-    std::rotate(tri.begin(), tri.begin() + first, tri.end());
+    const auto rotate = [first](Triangle& row) {
+      row = {row[first], row[(first + 1) % 3], row[(first + 2) % 3]};
+    };
+    rotate(tri);
     if (neighbours)
-      std::rotate((*neighbours)[t].begin(), (*neighbours)[t].begin() + first, (*neighbours)[t].end());
+      rotate((*neighbours)[t]);
   }
   // order: the triangles bucketed by their first id (a counting sort), each bucket in
   // increasing slot order; then each bucket (the few triangles sharing their smallest
