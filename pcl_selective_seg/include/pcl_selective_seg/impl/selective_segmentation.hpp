@@ -286,11 +286,12 @@ SelectiveSegmentation<PointT>::rankSegments(
   });
   segment_label.assign(num_segments, 0);
   result_.segments.resize(num_segments);
+  const Eigen::Matrix3f to_cloud = sensorToCloud();
   for (std::size_t r = 0; r < num_segments; ++r) {
     segment_label[order[r]] = static_cast<std::uint32_t>(r + 1);
     result_.segments[r].label = static_cast<std::uint32_t>(r + 1);
     result_.segments[r].num_points = sizes[order[r]];
-    result_.segments[r].normal = sensorToCloud() * segment_normals[order[r]];
+    result_.segments[r].normal = to_cloud * segment_normals[order[r]];
   }
   // Per-point labels and the counts of labeled, shared-vertex and normal-less points.
   result_.labels.resize(input_->size());
