@@ -51,9 +51,12 @@ buildOctree(const Scene& scene,
             double max_std_dev,
             std::size_t min_points = kMinPoints,
             const pcl::IndicesPtr& indices = nullptr,
-            const Eigen::Quaternionf* orientation = nullptr)
+            const Eigen::Quaternionf* orientation = nullptr,
+            unsigned int threads = 0)
 {
   auto octree = std::make_unique<Octree>(resolution);
+  if (threads > 0)
+    octree->setNumberOfThreads(threads);
   octree->setInputCloud(scene.cloud, indices);
   octree->setInputNormals(scene.normals, scene.areas);
   if (orientation)
@@ -559,14 +562,19 @@ TEST(OctreePointCloudNormalVariance, SameTreeAsPclInsertion)
   std::mt19937 rng(7);
   std::uniform_real_distribution<float> coordinate(-1.f, 1.f);
   Scene scene = ridge();
-  for (int k = 0; k < 5000; ++k) // scattered points, some sharing finest voxels
+  // Scattered points, some sharing finest voxels; enough for the parallel key
+  // generation and sort, with 1 to 3 threads.
+  for (int k = 0; k < 70000; ++k)
     scene.add(Eigen::Vector3f(coordinate(rng), coordinate(rng), 3.f + coordinate(rng)),
               Eigen::Vector3f(0.f, 0.f, -1.f),
               0.01);
   scene.add(Eigen::Vector3f(0.f, 0.f, 2.f), Eigen::Vector3f(0.f, 0.f, -1.f), 0.0);
-  for (const double resolution : {0.5, 0.05, 0.003}) {
+  for (const auto& [resolution, threads] : std::vector<std::pair<double, unsigned>>{
+           {0.5, 2}, {0.05, 1}, {0.05, 2}, {0.05, 3}, {0.003, 2}}) {
     SCOPED_TRACE(resolution);
-    const auto ours = buildOctree(scene, resolution, kPaperThreshold);
+    SCOPED_TRACE(threads);
+    const auto ours =
+        buildOctree(scene, resolution, kPaperThreshold, kMinPoints, nullptr, nullptr, threads);
     pcl::IndicesPtr valid(new pcl::Indices);
     for (pcl::index_t i = 0; i < static_cast<pcl::index_t>(scene.cloud->size()); ++i)
       if ((*scene.areas)[i] > 0.0) // the invalid point is not inserted
