@@ -175,6 +175,41 @@ starOf(pcl::index_t v,
        const std::vector<Triangle>& neighbours,
        std::vector<pcl::index_t>& star);
 
+/** Eq. 2-3 again at each vertex of \a seeds ((vertex, one of its triangles) pairs, a
+ * vertex possibly listed several times), summed over its star in increasing order as
+ * computeVertexNormals() sums it. */
+void
+recomputeOverStars(std::vector<std::pair<pcl::index_t, pcl::index_t>>& seeds,
+                   const std::vector<Triangle>& triangles,
+                   const std::vector<Triangle>& neighbours,
+                   const Vector3fVector& normals,
+                   const std::vector<double>& areas,
+                   Vector3fVector& vertex_normals,
+                   std::vector<double>& vertex_areas,
+                   int num_threads)
+{
+  std::sort(seeds.begin(), seeds.end());
+  seeds.erase(std::unique(seeds.begin(),
+                          seeds.end(),
+                          [](const auto& a, const auto& b) { return a.first == b.first; }),
+              seeds.end());
+  const auto num_seeds = static_cast<std::ptrdiff_t>(seeds.size());
+#pragma omp parallel num_threads(num_threads)
+  {
+    std::vector<pcl::index_t> star;
+#pragma omp for schedule(static)
+    for (std::ptrdiff_t k = 0; k < num_seeds; ++k) {
+      starOf(seeds[k].first, seeds[k].second, triangles, neighbours, star);
+      vertexNormal(star.data(),
+                   star.data() + star.size(),
+                   normals,
+                   areas,
+                   vertex_normals[seeds[k].first],
+                   vertex_areas[seeds[k].first]);
+    }
+  }
+}
+
 /** computeVertexNormals() for triangles listed by non-decreasing smallest vertex, with
  * their adjacency: each thread takes a run of triangles and adds their terms (eq. 2-3)
  * straight to the vertices it alone reaches; a vertex that an earlier run also reaches
@@ -232,25 +267,14 @@ scatterVertexNormals(std::size_t num_vertices,
   std::vector<std::pair<pcl::index_t, pcl::index_t>> redo;
   for (const auto& run : deferred)
     redo.insert(redo.end(), run.begin(), run.end());
-  std::sort(redo.begin(), redo.end());
-  redo.erase(std::unique(redo.begin(),
-                         redo.end(),
-                         [](const auto& a, const auto& b) { return a.first == b.first; }),
-             redo.end());
-#pragma omp parallel num_threads(static_cast<int>(runs))
-  {
-    std::vector<pcl::index_t> star;
-#pragma omp for schedule(static)
-    for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(redo.size()); ++k) {
-      starOf(redo[k].first, redo[k].second, triangles, neighbours, star);
-      vertexNormal(star.data(),
-                   star.data() + star.size(),
-                   normals,
-                   areas,
-                   vertex_normals[redo[k].first],
-                   vertex_areas[redo[k].first]);
-    }
-  }
+  recomputeOverStars(redo,
+                     triangles,
+                     neighbours,
+                     normals,
+                     areas,
+                     vertex_normals,
+                     vertex_areas,
+                     static_cast<int>(runs));
 }
 
 } // namespace
@@ -503,27 +527,14 @@ updateVertexNormals(const std::vector<Triangle>& triangles,
   for (const auto t : changed_triangles)
     for (const auto v : triangles[t])
       touched.emplace_back(v, t);
-  std::sort(touched.begin(), touched.end());
-  touched.erase(std::unique(touched.begin(),
-                            touched.end(),
-                            [](const auto& a, const auto& b) { return a.first == b.first; }),
-                touched.end());
-  const auto n_touched = static_cast<std::ptrdiff_t>(touched.size());
-#pragma omp parallel num_threads(threads(num_threads))
-  {
-    std::vector<pcl::index_t> star;
-#pragma omp for schedule(static)
-    for (std::ptrdiff_t k = 0; k < n_touched; ++k) {
-      // Its triangles in increasing order, as computeVertexNormals() sums them.
-      starOf(touched[k].first, touched[k].second, triangles, neighbours, star);
-      vertexNormal(star.data(),
-                   star.data() + star.size(),
-                   normals,
-                   areas,
-                   vertex_normals[touched[k].first],
-                   vertex_areas[touched[k].first]);
-    }
-  }
+  recomputeOverStars(touched,
+                     triangles,
+                     neighbours,
+                     normals,
+                     areas,
+                     vertex_normals,
+                     vertex_areas,
+                     threads(num_threads));
 }
 
 double
