@@ -149,6 +149,7 @@ TEST(SelectiveSegmentation, ThreadCountDoesNotChangeTheResult)
   // Large enough for the chunked (per-thread) sorts and incidence lists.
   const auto cloud = cubeScene(80000, 8);
   std::vector<SegmentationResult> results;
+  std::vector<std::vector<pcl::PointIndices>> all_clusters;
   for (const int threads : {1, 2, 3}) {
     SelectiveSegmentation<pcl::PointXYZL> seg;
     auto p = seg.getParameters();
@@ -157,10 +158,21 @@ TEST(SelectiveSegmentation, ThreadCountDoesNotChangeTheResult)
     std::vector<pcl::PointIndices> clusters;
     ASSERT_TRUE(segment<pcl::PointXYZL>(cloud, seg, clusters));
     results.push_back(seg.getResult());
+    all_clusters.push_back(clusters);
   }
   ASSERT_GT(results[0].mesh.triangles.size(), 65536u);
+  // Each cluster: its points in increasing order, all with its label.
+  for (std::size_t r = 0; r < all_clusters[0].size(); ++r) {
+    const auto& indices = all_clusters[0][r].indices;
+    EXPECT_TRUE(std::is_sorted(indices.begin(), indices.end()));
+    for (const auto i : indices)
+      ASSERT_EQ(results[0].labels[i], r + 1);
+  }
   for (const std::size_t k : {1u, 2u}) {
     SCOPED_TRACE(k + 1);
+    ASSERT_EQ(all_clusters[0].size(), all_clusters[k].size());
+    for (std::size_t r = 0; r < all_clusters[0].size(); ++r)
+      ASSERT_EQ(all_clusters[0][r].indices, all_clusters[k][r].indices);
     EXPECT_EQ(results[0].labels, results[k].labels);
     EXPECT_EQ(results[0].mesh.triangles, results[k].mesh.triangles);
     EXPECT_EQ(results[0].mesh.neighbours, results[k].mesh.neighbours);

@@ -776,8 +776,14 @@ SweepTriangulation::refan(const std::vector<QuantizedPoint>& points,
 void
 SweepTriangulation::neighbours(std::vector<Triangle>& out) const
 {
-  out.assign(triangles_.size(), Triangle{kNone, kNone, kNone});
-  for (index_t t = 0; t < static_cast<index_t>(triangles_.size()); ++t) {
+  out.resize(triangles_.size());
+  const auto num_triangles = static_cast<index_t>(triangles_.size());
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(num_threads_) schedule(static) \
+    if (num_triangles >= 65536)
+#endif
+  for (index_t t = 0; t < num_triangles; ++t) {
+    out[t] = Triangle{kNone, kNone, kNone};
     if (triangles_[t][0] == kNone)
       continue;
     // The edge opposite corner i is half-edge i + 1 (from corner i + 1 to i + 2).
