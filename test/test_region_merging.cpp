@@ -150,6 +150,32 @@ TEST(Incidence, VertexTriangles)
   EXPECT_EQ(inc.items, (std::vector<pcl::index_t>{0, 0, 1, 0, 1, 2, 1, 2, 2}));
 }
 
+TEST(ClustersFromLabels, PointsOfEachLabelInIncreasingOrder)
+{
+  using pcl::selective_seg::clustersFromLabels;
+  // Small by hand: label 0 and labels above the count are left out.
+  std::vector<pcl::PointIndices> clusters;
+  clustersFromLabels({2, 0, 1, 2, 5, 1, 2}, 3, clusters);
+  ASSERT_EQ(clusters.size(), 3u);
+  EXPECT_EQ(clusters[0].indices, (pcl::Indices{2, 5}));
+  EXPECT_EQ(clusters[1].indices, (pcl::Indices{0, 3, 6}));
+  EXPECT_TRUE(clusters[2].indices.empty());
+  // Large enough for one run per thread: the same lists for 1 to 3 threads.
+  std::vector<std::uint32_t> labels(100000);
+  for (std::size_t i = 0; i < labels.size(); ++i)
+    labels[i] = static_cast<std::uint32_t>((i * 7919) % 13);
+  std::vector<pcl::PointIndices> expected(12);
+  for (std::size_t i = 0; i < labels.size(); ++i)
+    if (labels[i] > 0)
+      expected[labels[i] - 1].indices.push_back(static_cast<pcl::index_t>(i));
+  for (const int threads : {1, 2, 3}) {
+    clustersFromLabels(labels, 12, clusters, threads);
+    ASSERT_EQ(clusters.size(), 12u);
+    for (std::size_t l = 0; l < 12; ++l)
+      EXPECT_EQ(clusters[l].indices, expected[l].indices) << threads << " threads";
+  }
+}
+
 TEST(MergeSeedSegments, SimilarSeedsMergeAcrossValidEdge)
 {
   // Seeds 10 degrees apart with equal areas; the joining triangles at 5 degrees.

@@ -41,21 +41,24 @@ private:
 };
 
 /** \brief Buckets by a counting sort: emit(item, f) calls f(group, value) for each entry
- * of the item; bucket g is values[offsets[g] .. offsets[g + 1]), its entries in the
- * order of their items (and of the calls within an item).
+ * of the item. Once the sizes are known, offsets[g] .. offsets[g + 1] is the range of
+ * bucket g (offsets has num_groups + 1 entries) and prepare(offsets) is called; then
+ * store(g, slot, value) places each entry at its slot in that range, the entries of a
+ * bucket in the order of their items (and of the calls within an item).
  *
  * With several threads the items are cut into one consecutive chunk per thread, each
- * chunk counted and then filled by its thread from its own cursors (a chunk's cursor
+ * chunk counted and then placed by its thread from its own cursors (a chunk's cursor
  * for a group starts after the earlier chunks' entries): the same buckets as one
  * thread gives. */
-template <typename Value, typename Emit, typename Values = std::vector<Value>>
+template <typename Value, typename Emit, typename Prepare, typename Store>
 void
-buildBuckets(std::size_t num_items,
-             std::size_t num_groups,
-             Emit emit,
-             int num_threads,
-             std::vector<std::size_t>& offsets,
-             Values& values)
+placeInBuckets(std::size_t num_items,
+               std::size_t num_groups,
+               Emit emit,
+               int num_threads,
+               std::vector<std::size_t>& offsets,
+               Prepare prepare,
+               Store store)
 {
   const std::size_t chunks =
       num_threads > 1 && num_items >= 65536 ? static_cast<std::size_t>(num_threads) : 1;
@@ -86,7 +89,7 @@ buildBuckets(std::size_t num_items,
     }
   }
   offsets[num_groups] = total;
-  values.resize(total);
+  prepare(static_cast<const std::vector<std::size_t>&>(offsets));
 #ifdef _OPENMP
 #pragma omp parallel for num_threads(static_cast<int>(chunks)) schedule(static, 1)
 #endif
@@ -94,9 +97,30 @@ buildBuckets(std::size_t num_items,
     auto& next = cursors[c];
     for (std::size_t i = chunk_begin(c); i < chunk_begin(c + 1); ++i)
       emit(i, [&](pcl::index_t g, const Value& value) {
-        values[next[static_cast<std::size_t>(g)]++] = value;
+        store(g, next[static_cast<std::size_t>(g)]++, value);
       });
   }
+}
+
+/** \brief placeInBuckets() into one array: bucket g is values[offsets[g] ..
+ * offsets[g + 1]). */
+template <typename Value, typename Emit, typename Values = std::vector<Value>>
+void
+buildBuckets(std::size_t num_items,
+             std::size_t num_groups,
+             Emit emit,
+             int num_threads,
+             std::vector<std::size_t>& offsets,
+             Values& values)
+{
+  placeInBuckets<Value>(
+      num_items,
+      num_groups,
+      emit,
+      num_threads,
+      offsets,
+      [&](const std::vector<std::size_t>& sizes) { values.resize(sizes.back()); },
+      [&](pcl::index_t, std::size_t slot, const Value& value) { values[slot] = value; });
 }
 
 /** \brief Compressed incidence lists: groups_of(item, f) calls f(group) for each group

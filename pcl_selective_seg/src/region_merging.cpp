@@ -26,6 +26,32 @@ Incidence::build(const std::vector<pcl::index_t>& group_of, std::size_t num_grou
   });
 }
 
+void
+clustersFromLabels(const std::vector<std::uint32_t>& labels,
+                   std::size_t num_labels,
+                   std::vector<pcl::PointIndices>& clusters,
+                   int num_threads)
+{
+  clusters.resize(num_labels);
+  std::vector<std::size_t> offsets;
+  detail::placeInBuckets<pcl::index_t>(
+      labels.size(),
+      num_labels,
+      [&](std::size_t i, auto f) {
+        if (labels[i] > 0 && labels[i] <= num_labels)
+          f(static_cast<pcl::index_t>(labels[i] - 1), static_cast<pcl::index_t>(i));
+      },
+      num_threads > 0 ? num_threads : static_cast<int>(defaultThreads()),
+      offsets,
+      [&](const std::vector<std::size_t>& bounds) {
+        for (std::size_t l = 0; l < num_labels; ++l)
+          clusters[l].indices.resize(bounds[l + 1] - bounds[l]);
+      },
+      [&](pcl::index_t l, std::size_t slot, pcl::index_t i) {
+        clusters[l].indices[slot - offsets[l]] = i;
+      });
+}
+
 Incidence
 vertexTriangles(const std::vector<Triangle>& triangles,
                 std::size_t num_vertices,

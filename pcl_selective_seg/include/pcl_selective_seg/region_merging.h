@@ -9,6 +9,7 @@
 #include <pcl_selective_seg/mesh_normals.h>
 #include <pcl_selective_seg/segmentation_result.h>
 
+#include <pcl/PointIndices.h>
 #include <pcl/types.h>
 
 #include <vector>
@@ -93,6 +94,15 @@ struct PCL_EXPORTS Incidence {
   static Incidence build(const std::vector<pcl::index_t>& group_of,
                          std::size_t num_groups);
 };
+
+/** \brief The points of each label: clusters[l - 1].indices lists the i with labels[i]
+ * == l, in increasing order, for l = 1 .. num_labels (label 0, and labels above
+ * num_labels, are left out). Headers are left as they are.
+ * \param[in] num_threads threads (0: all cores); the result does not depend on it */
+PCL_EXPORTS void clustersFromLabels(const std::vector<std::uint32_t>& labels,
+                                    std::size_t num_labels,
+                                    std::vector<pcl::PointIndices>& clusters,
+                                    int num_threads = 1);
 
 /** \brief Triangles at each vertex, in increasing triangle order.
  * \param[in] num_threads threads (0: all cores); the result does not depend on it */

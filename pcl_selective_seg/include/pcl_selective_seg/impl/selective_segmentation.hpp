@@ -467,44 +467,10 @@ SelectiveSegmentation<PointT>::segmentMesh(std::vector<pcl::PointIndices>& clust
   result_.timings.octree = watch.getTimeSeconds();
   watch.reset();
   mergeAndLabel();
-  // Each cluster lists its points in increasing order: the points are cut into one run
-  // per thread, each run's entries of a cluster placed after the earlier runs' (a
-  // counting sort), so the lists do not depend on the thread count.
-  clusters.resize(result_.segments.size());
-  for (std::size_t r = 0; r < clusters.size(); ++r) {
-    clusters[r].indices.resize(result_.segments[r].num_points);
-    clusters[r].header = input_->header;
-  }
-  const auto& labels = result_.labels;
-  const std::size_t num_points = labels.size();
-  const std::size_t runs =
-      numThreads() > 1 && num_points >= 65536 ? static_cast<std::size_t>(numThreads()) : 1;
-  std::vector<std::vector<std::size_t>> next(runs,
-                                             std::vector<std::size_t>(clusters.size(), 0));
-  const auto run_begin = [&](std::size_t c) { return c * num_points / runs; };
-#ifdef _OPENMP
-#pragma omp parallel for num_threads(static_cast<int>(runs)) schedule(static, 1)
-#endif
-  for (std::ptrdiff_t c = 0; c < static_cast<std::ptrdiff_t>(runs); ++c)
-    for (std::size_t i = run_begin(c); i < run_begin(c + 1); ++i)
-      if (labels[i] > 0)
-        ++next[c][labels[i] - 1];
-  for (std::size_t r = 0; r < clusters.size(); ++r) {
-    std::size_t placed = 0;
-    for (auto& run : next) {
-      const std::size_t count = run[r];
-      run[r] = placed;
-      placed += count;
-    }
-  }
-#ifdef _OPENMP
-#pragma omp parallel for num_threads(static_cast<int>(runs)) schedule(static, 1)
-#endif
-  for (std::ptrdiff_t c = 0; c < static_cast<std::ptrdiff_t>(runs); ++c)
-    for (std::size_t i = run_begin(c); i < run_begin(c + 1); ++i)
-      if (labels[i] > 0)
-        clusters[labels[i] - 1].indices[next[c][labels[i] - 1]++] =
-            static_cast<pcl::index_t>(i);
+  // Each cluster lists its points in increasing order, for any thread count.
+  clustersFromLabels(result_.labels, result_.segments.size(), clusters, numThreads());
+  for (auto& c : clusters)
+    c.header = input_->header;
   result_.timings.merge = watch.getTimeSeconds();
   if (result_.segments.empty())
     PCL_WARN("[pcl::selective_seg::%s::extract] no segment found\n",
