@@ -95,11 +95,16 @@ checkUpdate(const pcl::PointCloud<pcl::PointXYZ>& cloud,
     c->height = 1;
     c->is_dense = false;
   }
+  const auto configure = [&](SelectiveSegmentation<pcl::PointXYZ>& s,
+                              const SelectiveSegmentationParameters& p,
+                              const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& input) {
+    s.setParameters(p);
+    if (pose)
+      s.setSensorPose(*pose);
+    s.setInputCloud(input);
+  };
   SelectiveSegmentation<pcl::PointXYZ> seg;
-  seg.setParameters(params);
-  if (pose)
-    seg.setSensorPose(*pose);
-  seg.setInputCloud(old_points);
+  configure(seg, params, old_points);
   std::vector<pcl::PointIndices> clusters;
   if (!seg.extract(clusters))
     return; // nothing to update (checked: update() refuses)
@@ -110,10 +115,7 @@ checkUpdate(const pcl::PointCloud<pcl::PointXYZ>& cloud,
 
   auto all = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>(cloud);
   SelectiveSegmentation<pcl::PointXYZ> ref;
-  ref.setParameters(kept);
-  if (pose)
-    ref.setSensorPose(*pose);
-  ref.setInputCloud(all);
+  configure(ref, kept, all);
   std::vector<pcl::PointIndices> ref_clusters;
   const bool ref_ok = ref.extract(ref_clusters);
   check(updated == ref_ok, "update() and extract() on the union disagree on success");
