@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <numeric>
 #include <limits>
 #include <random>
 #include <vector>
@@ -496,11 +497,13 @@ TEST(MeshNormals, MedianEdgeLengthIsTheSampledEdgesMedianForAnyThreadCount)
   }
 }
 
-TEST(MeshNormals, ScatteredSumsEqualTheGatheredOnesToTheBit)
+TEST(MeshNormals, VertexSumsEqualTheGatheredOnesToTheBit)
 {
-  // With the adjacency and canonical order of delaunay2d(), computeVertexNormals() adds
-  // each triangle's terms to its vertices in one pass (split among threads, vertices
-  // reached by two runs redone over their stars); the gathered sums are the reference.
+  // computeVertexNormals() adds each triangle's terms to its vertices: with the
+  // adjacency and delaunay2d()'s canonical order in runs split among threads (vertices
+  // reached by two runs redone over their stars), else in one sequential pass or, for
+  // large meshes, through vertex -> triangle lists. Every path must give the sums
+  // gathered per vertex in increasing triangle order, to the bit.
   std::mt19937 rng(11);
   for (const int n : {50, 3000, 60000}) {
     std::vector<pcl::selective_seg::QuantizedPoint> angles;
@@ -523,28 +526,84 @@ TEST(MeshNormals, ScatteredSumsEqualTheGatheredOnesToTheBit)
     Vector3fVector normals;
     std::vector<double> areas;
     computeTriangleNormals(positions, triangles, Eigen::Vector3f::Zero(), normals, areas);
-    Vector3fVector gathered;
-    std::vector<double> gathered_areas;
-    computeVertexNormals(
-        positions.size(), triangles, normals, areas, gathered, gathered_areas, 1);
-    for (const int threads : {1, 2, 3}) {
-      Vector3fVector scattered;
-      std::vector<double> scattered_areas;
-      computeVertexNormals(positions.size(),
-                           triangles,
-                           normals,
-                           areas,
-                           scattered,
-                           scattered_areas,
-                           threads,
-                           &neighbours);
-      ASSERT_EQ(scattered.size(), gathered.size());
-      EXPECT_EQ(std::memcmp(scattered.data(),
-                            gathered.data(),
-                            gathered.size() * sizeof(Eigen::Vector3f)),
-                0)
-          << n << " points, " << threads << " threads";
-      EXPECT_EQ(scattered_areas, gathered_areas) << n << " points, " << threads;
+    // Reference: eq. 2-3 gathered per vertex over its triangles in increasing order.
+    const auto gather = [&](const std::vector<Triangle>& tris,
+                            const Vector3fVector& tri_normals,
+                            const std::vector<double>& tri_areas,
+                            Vector3fVector& vertex_normals,
+                            std::vector<double>& vertex_areas) {
+      std::vector<std::vector<std::size_t>> incident(positions.size());
+      for (std::size_t t = 0; t < tris.size(); ++t)
+        for (const auto v : tris[t])
+          incident[v].push_back(t);
+      vertex_normals.resize(positions.size());
+      vertex_areas.assign(positions.size(), 0.0);
+      for (std::size_t v = 0; v < positions.size(); ++v) {
+        Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+        for (const auto t : incident[v]) {
+          if (std::isfinite(tri_areas[t]))
+            vertex_areas[v] += tri_areas[t];
+          const double weight = 1.0 / tri_areas[t];
+          if (std::isfinite(tri_areas[t]) && tri_areas[t] > 0.0 && std::isfinite(weight) &&
+              tri_normals[t].allFinite())
+            sum += weight * tri_normals[t].cast<double>();
+        }
+        const double norm = sum.norm();
+        vertex_normals[v] =
+            norm > 0.0 && std::isfinite(norm)
+                ? Eigen::Vector3f((sum / norm).cast<float>())
+                : Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN());
+      }
+    };
+    // The same mesh with its triangles shuffled: not canonical, so a large one is
+    // gathered even with its adjacency.
+    std::vector<std::size_t> order(triangles.size());
+    std::iota(order.begin(), order.end(), std::size_t{0});
+    std::shuffle(order.begin(), order.end(), rng);
+    std::vector<Triangle> shuffled;
+    Vector3fVector shuffled_normals;
+    std::vector<double> shuffled_areas;
+    for (const auto t : order) {
+      shuffled.push_back(triangles[t]);
+      shuffled_normals.push_back(normals[t]);
+      shuffled_areas.push_back(areas[t]);
+    }
+    std::vector<Triangle> shuffled_neighbours;
+    pcl::selective_seg::computeTriangleNeighbours(
+        shuffled, positions.size(), shuffled_neighbours);
+    for (const bool reverse : {false, true}) {
+      const auto& tris = reverse ? shuffled : triangles;
+      const auto& tri_normals = reverse ? shuffled_normals : normals;
+      const auto& tri_areas = reverse ? shuffled_areas : areas;
+      Vector3fVector expected;
+      std::vector<double> expected_areas;
+      gather(tris, tri_normals, tri_areas, expected, expected_areas);
+      for (const bool with_adjacency : {true, false}) {
+        for (const int threads : {1, 2, 3}) {
+          Vector3fVector computed;
+          std::vector<double> computed_areas;
+          computeVertexNormals(positions.size(),
+                               tris,
+                               tri_normals,
+                               tri_areas,
+                               computed,
+                               computed_areas,
+                               threads,
+                               with_adjacency ? (reverse ? &shuffled_neighbours
+                                                         : &neighbours)
+                                              : nullptr);
+          ASSERT_EQ(computed.size(), expected.size());
+          EXPECT_EQ(std::memcmp(computed.data(),
+                                expected.data(),
+                                expected.size() * sizeof(Eigen::Vector3f)),
+                    0)
+              << n << " points, shuffled " << reverse << ", adjacency "
+              << with_adjacency << ", " << threads << " threads";
+          EXPECT_EQ(computed_areas, expected_areas)
+              << n << " points, shuffled " << reverse << ", adjacency "
+              << with_adjacency << ", " << threads << " threads";
+        }
+      }
     }
   }
 }

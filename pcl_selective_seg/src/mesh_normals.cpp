@@ -210,19 +210,24 @@ recomputeOverStars(std::vector<std::pair<pcl::index_t, pcl::index_t>>& seeds,
   }
 }
 
-/** computeVertexNormals() for triangles listed by non-decreasing smallest vertex, with
- * their adjacency: each thread takes a run of triangles and adds their terms (eq. 2-3)
- * straight to the vertices it alone reaches; a vertex that an earlier run also reaches
- * is left for the end, when its sum is redone over its whole star, in increasing order.
+/** computeVertexNormals() by adding each triangle's terms (eq. 2-3) to its vertices, in
+ * increasing triangle order: the same sums, in the same order, as the gather over each
+ * vertex's triangles. On one thread that holds for any triangle order. With the
+ * adjacency, the triangles are split into one run per thread: each thread adds straight
+ * to the vertices it alone reaches, and a vertex that an earlier run also reaches is
+ * left for the end, when its sum is redone over its whole star, in increasing order.
  *
- * Run c starts at triangle b_c with smallest vertex m_c; its triangles' vertices are at
- * least m_c and those of later runs at least m_(c+1), so run c adds directly to the
- * vertices in [m_c, m_(c+1)), which no later run reaches, and defers the others. A
- * vertex in [m_c, m_(c+1)) reached by an earlier run is deferred by that run. */
-void
+ * Run c starts at triangle b_c with smallest vertex m_c. If every triangle of runs c >= 1
+ * has its smallest vertex at least m_c and m_1 <= m_2 <= ... (true of delaunay2d()'s
+ * canonical order), run c adds directly to the vertices below m_(c+1), which no later
+ * run reaches, and defers the others; a vertex at or above m_c that an earlier run
+ * reaches is deferred by that run. False, with the outputs unspecified, if the triangles
+ * break that condition or a large mesh comes without its adjacency (then the gather
+ * does the work on all threads). */
+bool
 scatterVertexNormals(std::size_t num_vertices,
                      const std::vector<Triangle>& triangles,
-                     const std::vector<Triangle>& neighbours,
+                     const std::vector<Triangle>* neighbours,
                      const Vector3fVector& normals,
                      const std::vector<double>& areas,
                      Vector3fVector& vertex_normals,
@@ -230,20 +235,30 @@ scatterVertexNormals(std::size_t num_vertices,
                      int num_threads)
 {
   const std::size_t num_triangles = triangles.size();
-  const auto runs = static_cast<std::size_t>(
-      num_threads > 1 && num_triangles >= 65536 ? num_threads : 1);
+  const bool parallel = num_threads > 1 && num_triangles >= 65536;
+  if (parallel && !neighbours)
+    return false; // the gather runs on all threads
+  const auto runs = static_cast<std::size_t>(parallel ? num_threads : 1);
   std::vector<pcl::index_t> run_lowest(runs + 1);
   for (std::size_t c = 0; c < runs; ++c)
     run_lowest[c] = lowestVertex(triangles[c * num_triangles / runs]);
   run_lowest[runs] = static_cast<pcl::index_t>(num_vertices);
+  for (std::size_t c = 2; c < runs; ++c)
+    if (run_lowest[c] < run_lowest[c - 1])
+      return false;
   std::vector<Eigen::Vector3d> sums(num_vertices, Eigen::Vector3d::Zero());
   vertex_areas.assign(num_vertices, 0.0);
   std::vector<std::vector<std::pair<pcl::index_t, pcl::index_t>>> deferred(runs);
+  std::vector<char> out_of_order(runs, 0);
 #pragma omp parallel for num_threads(static_cast<int>(runs)) schedule(static, 1)
   for (std::ptrdiff_t c = 0; c < static_cast<std::ptrdiff_t>(runs); ++c) {
     const pcl::index_t upper = run_lowest[c + 1];
     for (std::size_t t = c * num_triangles / runs; t < (c + 1) * num_triangles / runs;
          ++t) {
+      if (c > 0 && lowestVertex(triangles[t]) < run_lowest[c]) {
+        out_of_order[c] = 1;
+        break;
+      }
       const bool finite_area = std::isfinite(areas[t]);
       const double weight = normalWeight(areas[t], normals[t]);
       const Eigen::Vector3d term = weight * normals[t].cast<double>();
@@ -259,22 +274,26 @@ scatterVertexNormals(std::size_t num_vertices,
       }
     }
   }
+  if (std::find(out_of_order.begin(), out_of_order.end(), 1) != out_of_order.end())
+    return false;
   vertex_normals.resize(num_vertices);
 #pragma omp parallel for num_threads(static_cast<int>(runs)) schedule(static)
   for (std::ptrdiff_t v = 0; v < static_cast<std::ptrdiff_t>(num_vertices); ++v)
     vertex_normals[v] = normalizedOrNaN(sums[v]);
-  // The deferred vertices, each once, over their stars.
+  // The deferred vertices, each once, over their stars (none with one run).
   std::vector<std::pair<pcl::index_t, pcl::index_t>> redo;
   for (const auto& run : deferred)
     redo.insert(redo.end(), run.begin(), run.end());
-  recomputeOverStars(redo,
-                     triangles,
-                     neighbours,
-                     normals,
-                     areas,
-                     vertex_normals,
-                     vertex_areas,
-                     static_cast<int>(runs));
+  if (!redo.empty())
+    recomputeOverStars(redo,
+                       triangles,
+                       *neighbours,
+                       normals,
+                       areas,
+                       vertex_normals,
+                       vertex_areas,
+                       static_cast<int>(runs));
+  return true;
 }
 
 } // namespace
@@ -289,20 +308,16 @@ computeVertexNormals(std::size_t num_vertices,
                      int num_threads,
                      const std::vector<Triangle>* neighbours)
 {
-  bool by_lowest_vertex = neighbours && neighbours->size() == triangles.size();
-  for (std::size_t t = 1; by_lowest_vertex && t < triangles.size(); ++t)
-    by_lowest_vertex = lowestVertex(triangles[t - 1]) <= lowestVertex(triangles[t]);
-  if (by_lowest_vertex) {
-    scatterVertexNormals(num_vertices,
-                         triangles,
-                         *neighbours,
-                         normals,
-                         areas,
-                         vertex_normals,
-                         vertex_areas,
-                         threads(num_threads));
+  const bool adjacency = neighbours && neighbours->size() == triangles.size();
+  if (scatterVertexNormals(num_vertices,
+                           triangles,
+                           adjacency ? neighbours : nullptr,
+                           normals,
+                           areas,
+                           vertex_normals,
+                           vertex_areas,
+                           threads(num_threads)))
     return;
-  }
   // Gathered per vertex over its triangles in increasing order: the same sums, in the
   // same order, whatever the number of threads.
   const Incidence incident =

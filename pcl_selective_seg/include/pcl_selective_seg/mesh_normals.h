@@ -52,11 +52,14 @@ PCL_EXPORTS void computeTriangleNormals(const Vector3fVector& positions,
  * \param[in] num_threads OpenMP threads, 0 = all cores (the result does not depend on
  * it)
  * \param[in] neighbours optional: the adjacency of \a triangles
- *            (computeTriangleNeighbours()). When given and the triangles are listed by
- *            non-decreasing smallest vertex (delaunay2d()'s canonical order), each
- *            triangle's terms are added to its vertices in one pass over the triangles
- *            instead of gathered through vertex -> triangle lists: the same sums in the
- *            same order (increasing triangle index), so the same bits.
+ *            (computeTriangleNeighbours()). Each triangle's terms are added to its
+ *            vertices in increasing triangle order: the same sums in the same order as
+ *            gathering them per vertex, so the same bits. Large meshes are split among
+ *            the threads when the adjacency is given and the triangles come in
+ *            delaunay2d()'s canonical order (by smallest vertex); without them the
+ *            sums of a large mesh are gathered through vertex -> triangle lists on all
+ *            threads (the same bits again). On one thread or below 65,536 triangles the
+ *            pass is sequential, for any triangle order.
  */
 PCL_EXPORTS void computeVertexNormals(std::size_t num_vertices,
                                       const std::vector<Triangle>& triangles,
