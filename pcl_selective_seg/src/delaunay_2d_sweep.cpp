@@ -766,8 +766,6 @@ SweepTriangulation::refan(const std::vector<QuantizedPoint>& points,
       circle_[e] = found->circle;
       if (found->twin != kNone)
         twins_[found->twin] = e;
-      else
-        boundary_edge_[key.from] = e;
     }
   }
   return true;
