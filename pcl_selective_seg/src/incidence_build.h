@@ -89,7 +89,7 @@ placeInBuckets(std::size_t num_items,
     }
   }
   offsets[num_groups] = total;
-  prepare(static_cast<const std::vector<std::size_t>&>(offsets));
+  prepare(offsets);
 #ifdef _OPENMP
 #pragma omp parallel for num_threads(static_cast<int>(chunks)) schedule(static, 1)
 #endif
