@@ -8,6 +8,8 @@
 
 #include <gtest/gtest.h>
 
+#include "delaunay_2d_backends.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -513,9 +515,12 @@ sweepMatchesBoost(const Points& points)
     // half-edges, across re-fanned co-circular groups) is the computed one.
     Triangles expected;
     computeTriangleNeighbours(boost, points.size(), expected);
-    // Large inputs take the parallel paths: the same result for 1 and 2 threads.
+    // Large inputs take the parallel paths: the same result for any thread count (the
+    // sweep triangulates one slab of the points per thread and stitches them).
     for (const auto backend : {DelaunayBackend::Sweep, DelaunayBackend::BoostVoronoi})
-      for (const unsigned int threads : {1u, 2u}) {
+      for (const unsigned int threads : {1u, 2u, 3u, 5u}) {
+        if (backend == DelaunayBackend::BoostVoronoi && threads > 2)
+          continue;
         Triangles triangles, neighbours;
         if (!pcl::selective_seg::delaunay2d(
                 points, backend, triangles, neighbours, nullptr, threads) ||
@@ -957,6 +962,103 @@ TEST(SweepMatchesBoost, LinesAndCurves)
   }
   EXPECT_TRUE(sweepMatchesBoost(opening_right));
   EXPECT_TRUE(sweepMatchesBoost(opening_up));
+}
+
+// The sweep on several threads triangulates slabs of the points (split between distinct
+// x) and re-triangulates the triangles whose circumdisks reach a neighbouring slab. Inputs
+// that stress the stitching: every split inside a run of equal x, lattices (co-circular
+// groups across the seams), flat strips (most circumdisks cross the seams), far-apart
+// clusters (wide gaps between the slabs' hulls), a collinear slab (no triangulation of
+// its own: the sweep runs in one piece), and slabs of very different sizes.
+/** Whether the sweep's slab path, with 1 to 7 slabs, gives Boost's triangles and their
+ * adjacency; \a applies: whether it is expected to apply (no collinear slab). */
+::testing::AssertionResult
+slabsMatchBoost(Points points, bool applies = true)
+{
+  std::sort(points.begin(), points.end());
+  const Triangles boost = triangulate(points, DelaunayBackend::BoostVoronoi);
+  Triangles expected;
+  computeTriangleNeighbours(boost, points.size(), expected);
+  for (const int slabs : {1, 2, 3, 4, 7}) {
+    Triangles triangles, neighbours;
+    const bool done = pcl::selective_seg::detail::delaunaySweepInSlabs(
+        points, slabs, triangles, neighbours);
+    if (done != applies)
+      return ::testing::AssertionFailure()
+             << points.size() << " points, " << slabs << " slabs: the slab path "
+             << (done ? "applied" : "did not apply");
+    if (done && (triangles != boost || neighbours != expected))
+      return ::testing::AssertionFailure()
+             << points.size() << " points, " << slabs << " slabs: "
+             << triangles.size() << " triangles against " << boost.size()
+             << " from Boost, or a different adjacency";
+  }
+  return ::testing::AssertionSuccess();
+}
+
+TEST(SweepMatchesBoost, SlabsAreStitchedExactly)
+{
+  std::mt19937 rng(11);
+  // The slab path called directly, with 1 to 7 slabs whatever the size.
+  EXPECT_TRUE(slabsMatchBoost(gridPoints(40, 30, -300, 500, 4, 6)));
+  EXPECT_TRUE(slabsMatchBoost(gridPoints(31, 31, 0, 0, 1, 1)));
+  EXPECT_TRUE(slabsMatchBoost(rotatedLatticePoints(20, 25, 4, 3)));
+  EXPECT_TRUE(slabsMatchBoost(circleLatticePoints(5525, 0, 0)));
+  EXPECT_TRUE(slabsMatchBoost(depthImagePoints(60, 50, 16000, 1, 40, true, rng)));
+  EXPECT_TRUE(slabsMatchBoost(depthImagePoints(60, 50, 16000, 0, 0, false, rng)));
+  EXPECT_TRUE(slabsMatchBoost(uniformPoints(2000, 1 << 20, rng)));
+  EXPECT_TRUE(slabsMatchBoost(gridPoints(1, 50, 0, 0, 3, 5), false));
+  // Small inputs in a tiny range: collinear and co-circular subsets everywhere, and
+  // slabs of a few points. Where a slab is collinear the path does not apply.
+  int applied = 0;
+  for (int round = 0; round < 2000; ++round) {
+    Points points = uniformPoints(12 + round % 40, 2 + round % 7, rng);
+    std::sort(points.begin(), points.end());
+    const Triangles boost = triangulate(points, DelaunayBackend::BoostVoronoi);
+    Triangles expected;
+    computeTriangleNeighbours(boost, points.size(), expected);
+    for (const int slabs : {2, 3}) {
+      Triangles triangles, neighbours;
+      if (!pcl::selective_seg::detail::delaunaySweepInSlabs(
+              points, slabs, triangles, neighbours))
+        continue;
+      ++applied;
+      EXPECT_TRUE(triangles == boost && neighbours == expected)
+          << "round " << round << ", " << slabs << " slabs";
+    }
+  }
+  EXPECT_GT(applied, 2000); // of 4000: most inputs have no collinear slab
+  // Through delaunay2d() on several threads (slabs of at least 8192 points):
+  // Columns of 200 points with equal x: the slab ends move to the next column.
+  EXPECT_TRUE(sweepMatchesBoost(gridPoints(150, 200, -3000, -5000, 40, 50)));
+  // Axis-aligned and tilted lattices: co-circular squares at every seam.
+  EXPECT_TRUE(sweepMatchesBoost(gridPoints(181, 181, 7, -9, 3, 3)));
+  EXPECT_TRUE(sweepMatchesBoost(rotatedLatticePoints(130, 140, 4, 3)));
+  // A flat strip: circumdisks far larger than the slabs.
+  Points strip;
+  for (int k = 0; k < 40000; ++k)
+    strip.push_back({static_cast<std::int32_t>(rng() % 20000000),
+                     static_cast<std::int32_t>(rng() % 50)});
+  EXPECT_TRUE(sweepMatchesBoost(distinctShuffled(strip, rng)));
+  // Clusters far apart in x, and one column holding half of the points.
+  Points clusters, column;
+  for (int k = 0; k < 36000; ++k) {
+    const std::int32_t centre = (k % 3) * 20000000 - 20000000;
+    clusters.push_back({centre + static_cast<std::int32_t>(rng() % 2001) - 1000,
+                        static_cast<std::int32_t>(rng() % 2001) - 1000});
+    column.push_back(k % 2 ? QuantizedPoint{0, k}
+                           : QuantizedPoint{1 + static_cast<std::int32_t>(rng() % 30000),
+                                            static_cast<std::int32_t>(rng() % 30000)});
+  }
+  EXPECT_TRUE(sweepMatchesBoost(distinctShuffled(clusters, rng)));
+  EXPECT_TRUE(sweepMatchesBoost(distinctShuffled(column, rng)));
+  // Dense and sparse halves (slabs of equal counts, very different widths), and
+  // random points at the coordinate limits.
+  Points uneven = uniformPoints(30000, 1000, rng);
+  for (const QuantizedPoint& p : uniformPoints(30000, 1 << 24, rng))
+    uneven.push_back({p[0] / 2 + (1 << 23) + 2000, p[1]});
+  EXPECT_TRUE(sweepMatchesBoost(distinctShuffled(uneven, rng)));
+  EXPECT_TRUE(sweepMatchesBoost(uniformPoints(50000, kMaxDelaunayCoordinate, rng)));
 }
 
 TEST(ComputeTriangleNeighbours, MatchesBruteForceOnDelaunayTriangulations)

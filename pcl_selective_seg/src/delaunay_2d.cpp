@@ -167,7 +167,7 @@ canonicalize(std::vector<Triangle>& triangles,
 void
 refanGroup(const std::vector<QuantizedPoint>& points,
            const std::vector<index_t>& group,
-           std::vector<Triangle>& triangles,
+           Triangle* triangles,
            std::vector<index_t>& corners)
 {
   corners.clear();
@@ -466,7 +466,7 @@ canonicalizeCoCircular(const std::vector<QuantizedPoint>& points,
     group.push_back(members[s].second);
     if (s + 1 == members.size() || members[s + 1].first != members[s].first) {
       if (group.size() > 1)
-        detail::refanGroup(points, group, triangles, corners);
+        detail::refanGroup(points, group, triangles.data(), corners);
       group.clear();
     }
   }

@@ -100,7 +100,7 @@ void canonicalize(std::vector<Triangle>& triangles,
  * lexicographically smallest point. \a corners is scratch space. */
 void refanGroup(const std::vector<QuantizedPoint>& points,
                 const std::vector<index_t>& group,
-                std::vector<Triangle>& triangles,
+                Triangle* triangles,
                 std::vector<index_t>& corners);
 
 /** \brief Exact Delaunay triangulation through the dual of Boost.Polygon's Voronoi
@@ -132,6 +132,19 @@ bool delaunaySweep(const std::vector<QuantizedPoint>& points,
                    std::vector<Triangle>* neighbours,
                    std::string* error,
                    int num_threads = 1);
+
+/** \brief The path delaunaySweep() takes on several threads, with \a num_slabs slabs
+ * whatever the number of points: the points, sorted lexicographically and distinct,
+ * split into slabs between distinct x, each triangulated by the sweep, the triangles
+ * whose circumdisks reach a neighbouring slab re-triangulated and stitched (see
+ * delaunay_2d_sweep.cpp). Gives the canonical triangles and their adjacency, or false
+ * (and nothing) where that path does not apply (a collinear slab, a slab over the sweep's
+ * flip budget, unsorted points) or a check of the stitching fails; delaunaySweep() then
+ * triangulates in one piece. For tests. */
+bool delaunaySweepInSlabs(const std::vector<QuantizedPoint>& points,
+                          int num_slabs,
+                          std::vector<Triangle>& triangles,
+                          std::vector<Triangle>& neighbours);
 
 /** \brief Triangulation by vtkDelaunay2D (floating point), triangles oriented counter-
  * clockwise by the exact orientation, degenerate ones dropped, not in canonical order.

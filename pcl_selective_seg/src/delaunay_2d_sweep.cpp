@@ -183,7 +183,21 @@ class SweepTriangulation {
 public:
   /** \a num_threads: threads of the final classification pass (the result does not
    * depend on it); the sweep itself is sequential. */
-  SweepTriangulation(const std::vector<QuantizedPoint>& points, int num_threads = 1);
+  SweepTriangulation(const std::vector<QuantizedPoint>& points, int num_threads = 1)
+  : SweepTriangulation(points.data(), points.size(), num_threads)
+  {}
+
+  /** The same over the \a count points from \a first. With \a storage, the triangles
+   * are written there (room for maxTriangles(count) of them) instead of in storage of
+   * its own. */
+  SweepTriangulation(const QuantizedPoint* first,
+                     std::size_t count,
+                     int num_threads,
+                     Triangle* storage = nullptr);
+
+  /** The most triangle slots the sweep of \a count points uses: it creates
+   * 2 (count + 2) - 5 triangles at most. */
+  static std::size_t maxTriangles(std::size_t count) { return 2 * count + 4; }
 
   /** Sweeps, completes the convex hull, removes the artificial points, then repairs and
    * classifies every edge (repairAndClassify()). Returns false, unfinished, if that
@@ -192,10 +206,23 @@ public:
    * while area-sampled clouds need fewer than one flip per point. */
   bool build();
 
-  /** Triangles, removed ones included (kNone corners). */
-  std::vector<Triangle>& triangles() { return triangles_; }
+  /** Triangles, removed ones included (kNone corners), in storage of its own (not
+   * with external storage). */
+  std::vector<Triangle>& triangles()
+  {
+    own_triangles_.resize(static_cast<std::size_t>(num_triangles_));
+    return own_triangles_;
+  }
 
-  index_t numHalfEdges() const { return 4 * static_cast<index_t>(triangles_.size()); }
+  /** Number of triangle slots used, removed ones included. */
+  index_t numTriangles() const { return num_triangles_; }
+
+  const Triangle& triangle(index_t t) const { return triangles_[t]; }
+
+  /** The input points (then the two artificial ones). */
+  const std::vector<QuantizedPoint>& points() const { return points_; }
+
+  index_t numHalfEdges() const { return 4 * num_triangles_; }
 
   index_t origin(index_t e) const { return triangles_[triangleOf(e)][cornerOf(e)]; }
 
@@ -215,6 +242,9 @@ public:
    * (neighbour i across the edge opposite corner i, -1 on the boundary), one row per
    * slot; rows of removed triangles are left -1. */
   void neighbours(std::vector<Triangle>& out) const;
+
+  /** The same, written to out[0], ..., out[numTriangles() - 1]. */
+  void neighbours(Triangle* out) const;
 
 private:
   /** What the last in-circle test of an edge found, while its two triangles remain. */
@@ -257,7 +287,9 @@ private:
   /** The input points, then the bottom and the top artificial point. */
   std::vector<QuantizedPoint> points_;
   index_t bottom_ = 0, top_ = 0;
-  std::vector<Triangle> triangles_;
+  std::vector<Triangle> own_triangles_;
+  Triangle* triangles_ = nullptr; // own_triangles_ or external storage
+  index_t num_triangles_ = 0;
   /** Per half-edge (four per triangle), allocated for the most triangles the sweep
    * can make: the twin, and the CircleState of the edge. */
   std::unique_ptr<index_t[]> twins_;
@@ -285,14 +317,20 @@ private:
   std::vector<BoundaryEdge> boundary_;
 };
 
-SweepTriangulation::SweepTriangulation(const std::vector<QuantizedPoint>& points,
-                                       int num_threads)
-    : points_(points), num_threads_(std::max(1, num_threads))
+SweepTriangulation::SweepTriangulation(const QuantizedPoint* first,
+                                       std::size_t count,
+                                       int num_threads,
+                                       Triangle* storage)
+    : num_threads_(std::max(1, num_threads))
 {
-  const auto n = static_cast<index_t>(points.size());
-  points_.reserve(points.size() + 2);
-  // The sweep creates 2 (n + 2) - 5 triangles at most.
-  triangles_.reserve(2 * static_cast<std::size_t>(n) + 4);
+  const auto n = static_cast<index_t>(count);
+  points_.reserve(count + 2);
+  points_.assign(first, first + count);
+  if (storage == nullptr) {
+    own_triangles_.resize(maxTriangles(count));
+    storage = own_triangles_.data();
+  }
+  triangles_ = storage;
   twins_.reset(new index_t[8 * static_cast<std::size_t>(n) + 16]);
   circle_.reset(new CircleState[8 * static_cast<std::size_t>(n) + 16]);
   front_next_.assign(n + 2, kNone);
@@ -578,7 +616,7 @@ index_t
 SweepTriangulation::addTriangle(index_t a, index_t b, index_t c)
 {
   const index_t e = numHalfEdges();
-  triangles_.push_back({a, b, c});
+  triangles_[num_triangles_++] = {a, b, c};
   circle_[e] = circle_[e + 1] = circle_[e + 2] = kUntested;
   return e;
 }
@@ -693,7 +731,7 @@ SweepTriangulation::repairAndClassify()
   // Every interior edge not yet classified, tested once from its lower half-edge (which
   // alone reads and writes the pair's states, so the triangles can be split among
   // threads); the illegal ones listed in increasing order, whatever the thread count.
-  const auto num_triangles = static_cast<index_t>(triangles_.size());
+  const index_t num_triangles = num_triangles_;
   const int threads = num_triangles >= 65536 ? num_threads_ : 1;
   std::vector<std::vector<index_t>> found(static_cast<std::size_t>(threads));
 #ifdef _OPENMP
@@ -774,8 +812,14 @@ SweepTriangulation::refan(const std::vector<QuantizedPoint>& points,
 void
 SweepTriangulation::neighbours(std::vector<Triangle>& out) const
 {
-  out.resize(triangles_.size());
-  const auto num_triangles = static_cast<index_t>(triangles_.size());
+  out.resize(static_cast<std::size_t>(num_triangles_));
+  neighbours(out.data());
+}
+
+void
+SweepTriangulation::neighbours(Triangle* out) const
+{
+  const index_t num_triangles = num_triangles_;
 #ifdef _OPENMP
 #pragma omp parallel for num_threads(num_threads_) schedule(static) \
     if (num_triangles >= 65536)
@@ -794,19 +838,20 @@ SweepTriangulation::neighbours(std::vector<Triangle>& out) const
 
 /** Splits every group of co-circular triangles (joined across marked edges: the
  * triangulation of one empty circle's polygon) by the canonical fan, in place. False
- * on an internal error (SweepTriangulation::refan()). */
+ * on an internal error (SweepTriangulation::refan()). \a visited: scratch space. */
 bool
-refanCoCircular(const std::vector<QuantizedPoint>& points, SweepTriangulation& mesh)
+refanCoCircular(const std::vector<QuantizedPoint>& points,
+                SweepTriangulation& mesh,
+                std::vector<char>& visited)
 {
-  std::vector<Triangle>& triangles = mesh.triangles();
-  std::vector<char> visited(triangles.size(), 0);
+  visited.assign(static_cast<std::size_t>(mesh.numTriangles()), 0);
   std::vector<index_t> group, pending;
   const auto on_circle = [&](index_t t) {
     return mesh.isOnCircle(4 * t) || mesh.isOnCircle(4 * t + 1) ||
            mesh.isOnCircle(4 * t + 2);
   };
-  for (index_t t = 0; t < static_cast<index_t>(triangles.size()); ++t) {
-    if (visited[t] || triangles[t][0] == kNone || !on_circle(t))
+  for (index_t t = 0; t < mesh.numTriangles(); ++t) {
+    if (visited[t] || mesh.triangle(t)[0] == kNone || !on_circle(t))
       continue;
     group.clear();
     pending.assign(1, t);
@@ -843,12 +888,378 @@ triangulateSorted(const std::vector<QuantizedPoint>& points,
   SweepTriangulation mesh(points, num_threads);
   if (!mesh.build())
     return false;
-  if (!refanCoCircular(points, mesh))
+  std::vector<char> visited;
+  if (!refanCoCircular(points, mesh, visited))
     return false;
   if (neighbours)
     mesh.neighbours(*neighbours);
   triangles.swap(mesh.triangles());
   return true;
+}
+
+// ------------------------------------------------------------ slabs in parallel
+
+/** Whether the closed circumdisk of the counter-clockwise triangle (a, b, c) lies
+ * strictly right of x = \a left (if \a has_left) and strictly left of x = \a right (if
+ * \a has_right), with a < right and a > left. Conservative: false when the rounding
+ * leaves it open.
+ *
+ * With b, c relative to a, the circumcentre is u = (nx, ny) / d with d = 2 orient(a, b,
+ * c) > 0, nx = cy |b|^2 - by |c|^2, ny = bx |c|^2 - cx |b|^2 (exact in int64 / int128).
+ * The disk stays left of a.x + s (s > 0) iff ux + |u| < s, iff uy^2 + 2 s ux < s^2,
+ * iff s^2 d^2 - ny^2 - 2 s nx d > 0; right of a.x - s iff s^2 d^2 - ny^2 + 2 s nx d > 0.
+ * These are evaluated in double from correctly rounded nx, ny, d: each of the three
+ * terms carries a relative error below 2^-50, so a value above 10^-12 times the sum of
+ * their magnitudes has the right sign. */
+bool
+circumdiskWithin(const QuantizedPoint& a,
+                 const QuantizedPoint& b,
+                 const QuantizedPoint& c,
+                 bool has_left,
+                 std::int32_t left,
+                 bool has_right,
+                 std::int32_t right)
+{
+  const std::int64_t bx = std::int64_t{b[0]} - a[0], by = std::int64_t{b[1]} - a[1];
+  const std::int64_t cx = std::int64_t{c[0]} - a[0], cy = std::int64_t{c[1]} - a[1];
+  const std::int64_t b2 = bx * bx + by * by, c2 = cx * cx + cy * cy;
+  const double d = static_cast<double>(2 * (bx * cy - by * cx));
+  const double nx = static_cast<double>(Int128{cy} * b2 - Int128{by} * c2);
+  const double ny = static_cast<double>(Int128{bx} * c2 - Int128{cx} * b2);
+  const double ny2 = ny * ny;
+  const auto clear = [&](double s, double sign) {
+    const double outer = s * s * d * d;
+    const double cross = 2 * s * nx * d * sign;
+    return outer - ny2 - cross > 1e-12 * (outer + ny2 + std::abs(cross));
+  };
+  return (!has_right || clear(static_cast<double>(std::int64_t{right} - a[0]), 1.0)) &&
+         (!has_left || clear(static_cast<double>(std::int64_t{a[0]} - left), -1.0));
+}
+
+/** Undirected edge key over point ids. */
+inline std::uint64_t
+undirectedKey(index_t a, index_t b)
+{
+  if (a > b)
+    std::swap(a, b);
+  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) |
+         static_cast<std::uint32_t>(b);
+}
+
+/** An edge of a kept triangle whose other side is re-triangulated, or on a slab's
+ * hull. */
+struct SeamEdge {
+  std::uint64_t key;
+  index_t from;  // the kept triangle runs from -> to (global ids)
+  index_t kept;  // slot of the kept triangle
+  index_t fresh; // slot of the new triangle across, or kNone
+  int corner;    // the edge is opposite this corner of the kept triangle
+  bool on_hull;  // no triangle across in the slab
+};
+
+/** One slab of the points: its slots in the shared arrays, and what the stitching
+ * needs of it. */
+struct Slab {
+  index_t first = 0, count = 0;    // its points: global ids [first, first + count)
+  index_t base = 0, capacity = 0;  // its slots [base, base + capacity)
+  std::vector<index_t> local;      // global ids of the points to re-triangulate
+  std::vector<SeamEdge> seam;      // edges of kept triangles towards the rest
+  std::vector<index_t> free_slots; // slots of the triangles not kept
+  std::vector<char> visited;       // scratch of refanCoCircular()
+  bool ok = false;
+};
+
+/** Triangulates a slab (sweep, canonical fans, adjacency) into its slots of \a
+ * triangles and \a neighbours, in global ids. Keeps the triangles whose closed
+ * circumdisk stays inside the slab's x range (Delaunay in the union too) and removes the
+ * others (kNone corners), listing their points, the slab's hull points and the edges of
+ * the kept triangles towards them or the hull. */
+void
+triangulateSlab(const std::vector<QuantizedPoint>& points,
+                Slab& slab,
+                std::unique_ptr<SweepTriangulation> mesh,
+                bool has_left,
+                bool has_right,
+                std::vector<Triangle>& triangles,
+                std::vector<Triangle>& neighbours)
+{
+  if (!mesh->build() || !refanCoCircular(mesh->points(), *mesh, slab.visited))
+    return;
+  const index_t num_slots = mesh->numTriangles();
+  mesh->neighbours(neighbours.data() + slab.base);
+  mesh.reset();
+  const index_t base = slab.base, end = slab.base + slab.capacity;
+  const QuantizedPoint* p = points.data() + slab.first;
+  const std::int32_t left = has_left ? points[slab.first - 1][0] : 0;
+  const std::int32_t right = has_right ? points[slab.first + slab.count][0] : 0;
+  // A triangle not kept is marked by its third corner v stored as -2 - v (neither a
+  // vertex nor kNone) until the second pass.
+  const auto isKept = [&triangles](index_t t) { return triangles[t][2] >= 0; };
+  for (index_t t = base; t < base + num_slots; ++t) {
+    Triangle& tri = triangles[t];
+    if (tri[0] != kNone &&
+        !circumdiskWithin(
+            p[tri[0]], p[tri[1]], p[tri[2]], has_left, left, has_right, right))
+      tri[2] = -2 - tri[2];
+  }
+  for (index_t t = base; t < end; ++t) {
+    Triangle& tri = triangles[t];
+    if (t >= base + num_slots || tri[0] == kNone) {
+      tri = {kNone, kNone, kNone};
+      slab.free_slots.push_back(t);
+      continue;
+    }
+    if (!isKept(t)) {
+      for (const index_t v : {tri[0], tri[1], -2 - tri[2]})
+        slab.local.push_back(slab.first + v);
+      slab.free_slots.push_back(t);
+      continue;
+    }
+    Triangle& row = neighbours[t];
+    for (int i = 0; i < 3; ++i) {
+      index_t& u = row[i];
+      if (u != kNone) {
+        u += base;
+        if (isKept(u))
+          continue;
+      }
+      const index_t from = slab.first + tri[(i + 1) % 3];
+      const index_t to = slab.first + tri[(i + 2) % 3];
+      slab.seam.push_back({undirectedKey(from, to), from, t, kNone, i, u == kNone});
+      if (u == kNone) {
+        slab.local.push_back(from);
+        slab.local.push_back(to);
+      }
+      u = kNone;
+    }
+  }
+  // Global ids, and the removed triangles' slots free.
+  for (index_t t = base; t < end; ++t) {
+    Triangle& tri = triangles[t];
+    if (tri[0] != kNone && tri[2] >= 0)
+      for (auto& v : tri)
+        v += slab.first;
+    else
+      tri = {kNone, kNone, kNone};
+  }
+  slab.ok = true;
+}
+
+/** triangulateSorted()'s triangulation and adjacency (by slot, removed slots kNone),
+ * computed on \a num_slabs slabs of the points at once (one per thread) and stitched.
+ *
+ * The slabs split the points between distinct x. A triangle of a slab's triangulation
+ * whose closed circumdisk holds no point of the neighbouring slabs (it stays strictly
+ * inside the slab's x range, circumdiskWithin()) has an empty open circumdisk in the
+ * union, and its co-circular group, all in the slab, is split the same way there: it
+ * is a triangle of the union's triangulation ("kept"). The rest of the union's hull,
+ * the region R (the other triangles and the gaps between the slabs' hulls), is tiled by
+ * union triangles whose corners lie in the closure of R: corners of the other triangles
+ * and the slabs' hull points. With those points L, every union triangle in R is a
+ * triangle of DT(L), with the same canonical split, and the edges between R and the
+ * kept triangles are edges of DT(L): the triangles of DT(L) found by a flood from those
+ * edges, stopped by them, re-tile R (as in insertDelaunayPoints()). They go into free
+ * slots (there are always enough: the slots of a slab hold maxTriangles() triangles).
+ * Checked: every edge between a kept triangle and R is met by exactly one new
+ * triangle, and Euler's count holds for the whole mesh. False (the output is then
+ * unusable) if a slab is collinear, over the sweep's budget, or a check fails: the
+ * caller triangulates in one piece. */
+bool
+triangulateSortedInSlabs(const std::vector<QuantizedPoint>& points,
+                         int num_slabs,
+                         std::vector<Triangle>& triangles,
+                         std::vector<Triangle>& neighbours)
+{
+  const auto n = static_cast<index_t>(points.size());
+  std::vector<Slab> slabs(static_cast<std::size_t>(num_slabs));
+  index_t begin = 0, slots = 0;
+  for (int s = 0; s < num_slabs; ++s) {
+    index_t end = s + 1 == num_slabs
+                      ? n
+                      : static_cast<index_t>(std::int64_t{n} * (s + 1) / num_slabs);
+    while (end < n && end > begin && points[end - 1][0] == points[end][0])
+      ++end;
+    if (end - begin < 3)
+      return false;
+    const QuantizedPoint* p = points.data() + begin;
+    bool collinear = true;
+    for (index_t i = 2; i < end - begin && collinear; ++i)
+      collinear = orientation(p[0], p[1], p[i]) == 0;
+    if (collinear)
+      return false;
+    slabs[s].first = begin;
+    slabs[s].count = end - begin;
+    slabs[s].base = slots;
+    slabs[s].capacity = static_cast<index_t>(
+        SweepTriangulation::maxTriangles(static_cast<std::size_t>(end - begin)));
+    slots += slabs[s].capacity;
+    begin = end;
+  }
+  if (begin != n)
+    return false;
+
+  // The shared arrays and the sweeps' own are allocated here, on the calling thread:
+  // memory a worker thread allocates comes from its own malloc arena, which the later
+  // stages of a segmentation would not reuse.
+  triangles.resize(static_cast<std::size_t>(slots));
+  neighbours.resize(static_cast<std::size_t>(slots));
+  std::vector<std::unique_ptr<SweepTriangulation>> meshes(slabs.size());
+  for (std::size_t s = 0; s < slabs.size(); ++s) {
+    slabs[s].visited.reserve(static_cast<std::size_t>(slabs[s].capacity));
+    meshes[s].reset(new SweepTriangulation(points.data() + slabs[s].first,
+                                           static_cast<std::size_t>(slabs[s].count),
+                                           1,
+                                           triangles.data() + slabs[s].base));
+  }
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(num_slabs) schedule(static, 1)
+#endif
+  for (int s = 0; s < num_slabs; ++s)
+    triangulateSlab(points,
+                    slabs[s],
+                    std::move(meshes[s]),
+                    s > 0,
+                    s + 1 < num_slabs,
+                    triangles,
+                    neighbours);
+  std::vector<index_t> local;
+  std::vector<SeamEdge> seam;
+  for (Slab& slab : slabs) {
+    if (!slab.ok)
+      return false;
+    slab.visited = std::vector<char>();
+    local.insert(local.end(), slab.local.begin(), slab.local.end());
+    seam.insert(seam.end(), slab.seam.begin(), slab.seam.end());
+  }
+  std::sort(local.begin(), local.end());
+  local.erase(std::unique(local.begin(), local.end()), local.end());
+  std::sort(seam.begin(), seam.end(), [](const SeamEdge& a, const SeamEdge& b) {
+    return a.key < b.key;
+  });
+  const auto findSeam = [&seam](std::uint64_t key) -> SeamEdge* {
+    const auto it = std::lower_bound(
+        seam.begin(), seam.end(), key, [](const SeamEdge& e, std::uint64_t k) {
+          return e.key < k;
+        });
+    return it != seam.end() && it->key == key ? &*it : nullptr;
+  };
+
+  // DT(L), and the flood from the seam into R.
+  std::vector<QuantizedPoint> local_points(local.size());
+  for (std::size_t i = 0; i < local.size(); ++i)
+    local_points[i] = points[local[i]];
+  std::vector<Triangle> local_tris, local_nbrs;
+  if (!detail::delaunaySweep(local_points, local_tris, &local_nbrs, nullptr) ||
+      local_tris.empty())
+    return false;
+  const auto edgeFrom = [&](index_t t, int i) { return local[local_tris[t][(i + 1) % 3]]; };
+  const auto edgeTo = [&](index_t t, int i) { return local[local_tris[t][(i + 2) % 3]]; };
+  std::size_t num_kept = 0;
+  for (const Slab& slab : slabs)
+    num_kept += static_cast<std::size_t>(slab.capacity) - slab.free_slots.size();
+  // With no kept triangle, R is the whole hull; otherwise each part of R borders a kept
+  // triangle (a part bounded by the hull alone would be the whole hull).
+  std::vector<index_t> slot_of(local_tris.size(), num_kept == 0 ? 0 : kNone);
+  std::vector<index_t> stack;
+  for (index_t t = 0; t < static_cast<index_t>(local_tris.size()); ++t)
+    for (int i = 0; i < 3 && slot_of[t] == kNone; ++i) {
+      const SeamEdge* e = findSeam(undirectedKey(edgeFrom(t, i), edgeTo(t, i)));
+      // R lies left of to -> from, the kept triangle's edge reversed.
+      if (e && e->from == edgeTo(t, i)) {
+        slot_of[t] = 0;
+        stack.push_back(t);
+      }
+    }
+  while (!stack.empty()) {
+    const index_t t = stack.back();
+    stack.pop_back();
+    for (int i = 0; i < 3; ++i) {
+      const index_t u = local_nbrs[t][i];
+      if (u == kNone || slot_of[u] != kNone ||
+          findSeam(undirectedKey(edgeFrom(t, i), edgeTo(t, i))))
+        continue;
+      slot_of[u] = 0;
+      stack.push_back(u);
+    }
+  }
+  // The new triangles' slots: the free ones, slab by slab.
+  std::size_t next_slab = 0, next_free = 0;
+  for (index_t& slot : slot_of) {
+    if (slot == kNone)
+      continue;
+    while (next_slab < slabs.size() && next_free == slabs[next_slab].free_slots.size()) {
+      ++next_slab;
+      next_free = 0;
+    }
+    if (next_slab == slabs.size())
+      return false;
+    slot = slabs[next_slab].free_slots[next_free++];
+  }
+
+  // The new triangles and their adjacency, and across the seam.
+  std::size_t hull_edges = 0, total = num_kept;
+  for (index_t t = 0; t < static_cast<index_t>(local_tris.size()); ++t) {
+    const index_t id = slot_of[t];
+    if (id == kNone)
+      continue;
+    ++total;
+    for (int i = 0; i < 3; ++i) {
+      triangles[id][i] = local[local_tris[t][i]];
+      const index_t u = local_nbrs[t][i];
+      if (u != kNone && slot_of[u] != kNone) {
+        neighbours[id][i] = slot_of[u];
+        continue;
+      }
+      SeamEdge* e = findSeam(undirectedKey(edgeFrom(t, i), edgeTo(t, i)));
+      if (e == nullptr) {
+        if (u != kNone) // the flood crossed every other edge
+          return false;
+        neighbours[id][i] = kNone;
+        ++hull_edges;
+        continue;
+      }
+      if (e->fresh != kNone || e->from != edgeTo(t, i))
+        return false;
+      e->fresh = id;
+      neighbours[id][i] = e->kept;
+      neighbours[e->kept][e->corner] = id;
+    }
+  }
+  for (const SeamEdge& e : seam) {
+    if (e.fresh == kNone && !e.on_hull)
+      return false;
+    hull_edges += e.fresh == kNone;
+  }
+  // Euler: a triangulation of n points, h of them on its boundary, has 2n - h - 2
+  // triangles (every point is a vertex of a Delaunay triangulation).
+  return 2 * points.size() >= hull_edges + 2 &&
+         total == 2 * points.size() - hull_edges - 2;
+}
+
+/** Fewest points per slab worth a thread of their own. */
+constexpr std::size_t kMinSlabPoints = 8192;
+
+/** triangulateSorted(), on up to \a num_threads slabs at once when the points are many
+ * enough (triangulateSortedInSlabs(); by slot, not in canonical order either way). The
+ * result does not depend on the number of slabs. */
+bool
+triangulateSortedOnThreads(const std::vector<QuantizedPoint>& points,
+                           std::vector<Triangle>& triangles,
+                           std::vector<Triangle>* neighbours,
+                           int num_threads)
+{
+  const auto slabs = static_cast<int>(std::min<std::size_t>(
+      static_cast<std::size_t>(std::max(1, std::min(num_threads, 8))),
+      points.size() / kMinSlabPoints));
+  if (slabs >= 2) {
+    std::vector<Triangle> own_neighbours;
+    std::vector<Triangle>& adjacency = neighbours ? *neighbours : own_neighbours;
+    if (triangulateSortedInSlabs(points, slabs, triangles, adjacency))
+      return true;
+    triangles.clear();
+    adjacency.clear();
+  }
+  return triangulateSorted(points, triangles, neighbours, num_threads);
 }
 
 /** BoostVoronoi's triangles in canonical order, for the inputs the sweep gives up on:
@@ -884,7 +1295,7 @@ delaunaySweep(const std::vector<QuantizedPoint>& points,
   if (isStrictlySorted(points)) {
     if (points.size() < 3 || allCollinear(points))
       return true;
-    if (!triangulateSorted(points, triangles, neighbours, num_threads))
+    if (!triangulateSortedOnThreads(points, triangles, neighbours, num_threads))
       return triangulateByBoost(points, triangles, neighbours, error);
     canonicalize(triangles, points.size(), neighbours, num_threads);
     return true;
@@ -901,13 +1312,31 @@ delaunaySweep(const std::vector<QuantizedPoint>& points,
     sorted[i] = points[order[i]];
   if (points.size() < 3 || allCollinear(sorted))
     return true;
-  if (!triangulateSorted(sorted, triangles, neighbours, num_threads))
+  if (!triangulateSortedOnThreads(sorted, triangles, neighbours, num_threads))
     return triangulateByBoost(points, triangles, neighbours, error);
   for (auto& t : triangles)
     if (t[0] != kNone)
       for (auto& v : t)
         v = order[v];
   canonicalize(triangles, points.size(), neighbours, num_threads);
+  return true;
+}
+
+bool
+delaunaySweepInSlabs(const std::vector<QuantizedPoint>& points,
+                     int num_slabs,
+                     std::vector<Triangle>& triangles,
+                     std::vector<Triangle>& neighbours)
+{
+  triangles.clear();
+  neighbours.clear();
+  if (num_slabs < 1 || !isStrictlySorted(points) ||
+      !triangulateSortedInSlabs(points, num_slabs, triangles, neighbours)) {
+    triangles.clear();
+    neighbours.clear();
+    return false;
+  }
+  canonicalize(triangles, points.size(), &neighbours);
   return true;
 }
 
