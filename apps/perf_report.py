@@ -94,7 +94,8 @@ def markdown(context, runs, rows, memory, load=None):
            "build, this 2-core machine, real time; the pipeline is the median of 3 "
            "repetitions, the peer one run. Timings are never asserted in tests.", "",
            f"Machine: {context.get('num_cpus', '?')} CPUs at "
-           f"{context.get('mhz_per_cpu', '?')} MHz, date {context.get('date', '?')}."
+           f"{context.get('mhz_per_cpu', '?')} MHz, date {context.get('date', '?')}, "
+           f"OpenMP wait policy {os.environ.get('OMP_WAIT_POLICY') or 'default'}."
            + load_note(load), "",
            "## Whole pipeline by size and stage (simulated door scans, Fig. 6)", "",
            "| points | Delaunay (s) | Normal Calc. (s) | Octree Gen. (s) | Merge Voxels (s) "
