@@ -363,7 +363,11 @@ SelectiveSegmentation<PointT>::fillMeshAndLeaves(
   const auto& leaves = octree_->getAdaptiveLeaves();
   const Eigen::Affine3f sensor_pose = delaunay_.getSensorPose();
   result_.leaves.resize(leaves.size());
-  for (std::size_t l = 0; l < leaves.size(); ++l) {
+  const auto num_leaves = static_cast<std::ptrdiff_t>(leaves.size());
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(numThreads()) schedule(static)
+#endif
+  for (std::ptrdiff_t l = 0; l < num_leaves; ++l) {
     OctreeLeaf& out = result_.leaves[l];
     out.centre = sensor_pose * octree_->getVoxelCentre(leaves[l]);
     out.size = static_cast<float>(octree_->getVoxelSideLength(leaves[l].depth));
@@ -374,6 +378,9 @@ SelectiveSegmentation<PointT>::fillMeshAndLeaves(
     out.sigma_phi = leaves[l].sigma_phi;
     out.area = leaves[l].area;
     out.num_points = static_cast<std::uint32_t>(leaves[l].end - leaves[l].begin);
+  }
+  // Segment areas summed in leaf order, whatever the thread count.
+  for (const OctreeLeaf& out : result_.leaves) {
     result_.segments[out.label - 1].area += out.area;
     ++result_.segments[out.label - 1].num_leaves;
   }
