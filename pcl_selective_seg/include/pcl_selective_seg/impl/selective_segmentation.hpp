@@ -19,6 +19,10 @@
 #include <limits>
 #include <numeric>
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 namespace pcl {
 namespace selective_seg {
 
@@ -274,10 +278,32 @@ SelectiveSegmentation<PointT>::rankSegments(
 {
   const SphericalTriangulation& tri = delaunay_.getTriangulation();
   const std::size_t num_segments = segment_normals.size();
-  std::vector<std::size_t> sizes(num_segments, 0);
-  for (const auto v : tri.point_vertex)
-    if (v >= 0 && vertex_segment[v] >= 0)
-      ++sizes[vertex_segment[v]];
+  // Points per segment: counted per thread (the counts allocated here, on the calling
+  // thread), then added up.
+  const int threads = numThreads();
+  std::vector<std::vector<std::size_t>> counts(
+      static_cast<std::size_t>(threads), std::vector<std::size_t>(num_segments, 0));
+  const auto num_mapped = static_cast<std::ptrdiff_t>(tri.point_vertex.size());
+#ifdef _OPENMP
+#pragma omp parallel num_threads(threads)
+#endif
+  {
+#ifdef _OPENMP
+    std::vector<std::size_t>& mine = counts[static_cast<std::size_t>(omp_get_thread_num())];
+#pragma omp for schedule(static)
+#else
+    std::vector<std::size_t>& mine = counts[0];
+#endif
+    for (std::ptrdiff_t i = 0; i < num_mapped; ++i) {
+      const pcl::index_t v = tri.point_vertex[i];
+      if (v >= 0 && vertex_segment[v] >= 0)
+        ++mine[static_cast<std::size_t>(vertex_segment[v])];
+    }
+  }
+  std::vector<std::size_t> sizes = std::move(counts[0]);
+  for (std::size_t t = 1; t < counts.size(); ++t)
+    for (std::size_t k = 0; k < num_segments; ++k)
+      sizes[k] += counts[t][k];
   // Largest first; ties keep the (data-determined) creation order.
   std::vector<std::size_t> order(num_segments);
   std::iota(order.begin(), order.end(), 0);
