@@ -1137,5 +1137,16 @@ int
 main(int argc, char** argv)
 {
   testing::InitGoogleTest(&argc, argv);
-  return RUN_ALL_TESTS();
+  // The tests run the sweep on up to 7 threads. LLVM's libomp (14) loses a few
+  // kilobytes of thread descriptors when a team grows by two or more threads after a
+  // team of several (2 then 5 threads: LeakSanitizer reports it in a ten-line program
+  // with no code of this project). Opening the largest team first keeps every later
+  // team within it, so the sanitizer suite reports this project's leaks only.
+  int largest_team = 0;
+#pragma omp parallel num_threads(8)
+  {
+#pragma omp atomic
+    ++largest_team;
+  }
+  return largest_team > 0 ? RUN_ALL_TESTS() : 1;
 }
