@@ -102,10 +102,11 @@ seedOrder(const std::vector<pcl::index_t>& vertex_leaf, std::size_t num_leaves)
 
 /** A triangle listed under a leaf, with the leaves of its vertices (-1: none) kept
  * beside it: the growth reads them for every triangle it visits, and a copy next to
- * the triangle id saves it three scattered reads per visit. */
+ * the triangle id saves it three scattered reads per visit. An edge-on triangle (never
+ * a valid edge triangle) is stored as ~t, which saves the read of its flag too. */
 struct LeafTriangle {
   std::array<pcl::index_t, 3> leaves;
-  pcl::index_t triangle;
+  pcl::index_t triangle; ///< t, or ~t (negative) for an edge-on triangle
 };
 
 /** The triangles at each leaf that can matter to the growth: every triangle whose
@@ -125,7 +126,9 @@ struct LeafTriangles {
         [&](std::size_t t, auto f) {
           const auto leaves = leavesOf(static_cast<pcl::index_t>(t));
           if (spansLeaves(leaves)) {
-            const LeafTriangle entry{leaves, static_cast<pcl::index_t>(t)};
+            const bool edge_on = in.triangle_edge_on && (*in.triangle_edge_on)[t];
+            const auto id = static_cast<pcl::index_t>(t);
+            const LeafTriangle entry{leaves, edge_on ? ~id : id};
             forEachDistinct(leaves, [&](pcl::index_t l) { f(l, entry); });
           }
         },
@@ -199,7 +202,7 @@ private:
       for (auto i = adjacency_.offsets[leaf]; i < end; ++i) {
         // The triangles' normals are scattered: ask for one a few entries ahead (a
         // hint; no effect on the values).
-        if (i + 8 < end)
+        if (i + 8 < end && adjacency_.entries[i + 8].triangle >= 0)
           __builtin_prefetch(&(*in_.triangle_normals)[adjacency_.entries[i + 8].triangle]);
         visitTriangle(adjacency_.entries[i], k, segment, leaf_segment);
       }
@@ -217,8 +220,8 @@ private:
     const bool edge = std::any_of(leaves.begin(), leaves.end(), [&](pcl::index_t l) {
       return l >= 0 && leaf_segment[l] != k;
     });
-    if (!edge || !isValidFor(t, segment.normal))
-      return; // interior, or an invalid edge triangle (eq. 8)
+    if (!edge || t < 0 || !isValidFor(t, segment.normal))
+      return; // interior, or an invalid edge triangle (eq. 8; t < 0: edge-on)
     for (const auto other : leaves) {
       if (other < 0 || leaf_segment[other] >= 0)
         continue;
@@ -231,10 +234,11 @@ private:
     }
   }
 
+  /** Eq. 8 for a triangle that is not edge-on. */
   bool isValidFor(pcl::index_t t, const Eigen::Vector3d& segment_normal) const
   {
     const Eigen::Vector3f& n_t = (*in_.triangle_normals)[t];
-    if (!n_t.allFinite() || (in_.triangle_edge_on && (*in_.triangle_edge_on)[t]))
+    if (!n_t.allFinite())
       return false;
     return n_t.cast<double>().dot(segment_normal) >= cos_edge_;
   }
