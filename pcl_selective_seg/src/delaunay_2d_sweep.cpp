@@ -1237,7 +1237,7 @@ triangulateSortedInSlabs(const std::vector<QuantizedPoint>& points,
 }
 
 /** Fewest points per slab worth a thread of their own. */
-constexpr std::size_t kMinSlabPoints = 8192;
+constexpr std::size_t kMinSlabPoints = 2048;
 
 /** triangulateSorted(), on up to \a num_threads slabs at once when the points are many
  * enough (triangulateSortedInSlabs(); by slot, not in canonical order either way). The
