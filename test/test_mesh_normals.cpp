@@ -472,7 +472,7 @@ TEST(MeshNormals, MedianEdgeLengthIsTheSampledEdgesMedianForAnyThreadCount)
   std::mt19937 rng(7);
   std::uniform_real_distribution<float> coordinate(-1.f, 1.f);
   std::uniform_int_distribution<int> scale(-20, 20);
-  for (const std::size_t num_triangles : {1u, 2u, 5u, 999u, 100000u, 250001u}) {
+  for (const std::size_t num_triangles : {1u, 2u, 5u, 999u, 20000u, 100000u, 250001u}) {
     Vector3fVector positions(600);
     for (auto& p : positions)
       p = Eigen::Vector3f(coordinate(rng), coordinate(rng), coordinate(rng)) *
@@ -505,7 +505,7 @@ TEST(MeshNormals, VertexSumsEqualTheGatheredOnesToTheBit)
   // large meshes, through vertex -> triangle lists. Every path must give the sums
   // gathered per vertex in increasing triangle order, to the bit.
   std::mt19937 rng(11);
-  for (const int n : {50, 3000, 60000}) {
+  for (const int n : {50, 3000, 12000, 60000}) {
     std::vector<pcl::selective_seg::QuantizedPoint> angles;
     std::uniform_int_distribution<std::int32_t> coordinate(0, 4 * n);
     while (angles.size() < static_cast<std::size_t>(n))

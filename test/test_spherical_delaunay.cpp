@@ -336,9 +336,12 @@ TEST(SphericalDelaunay, BadQuantizationRefused)
 TEST(RadixSort, StableAndThreadIndependent)
 {
   std::mt19937_64 rng(11);
+  // Sizes on both sides of the threaded path's threshold (8,192 entries).
+  for (const std::size_t size : {8191u, 8192u, 10001u, 150000u})
   for (const int bits : {1, 7, 22, 33, 50, 64}) {
     SCOPED_TRACE(bits);
-    std::vector<std::pair<std::uint64_t, pcl::index_t>> entries(150000);
+    SCOPED_TRACE(size);
+    std::vector<std::pair<std::uint64_t, pcl::index_t>> entries(size);
     const std::uint64_t mask = bits == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << bits) - 1;
     for (std::size_t i = 0; i < entries.size(); ++i) // many equal keys
       entries[i] = {(rng() % 5000) * 0x9e3779b97f4a7c15ull & mask,

@@ -46,7 +46,7 @@ radixSortByKey(std::vector<std::pair<std::uint64_t, pcl::index_t>>& entries,
   const int digit_bits = (bits + passes - 1) / passes;
   const std::size_t digits = std::size_t{1} << digit_bits;
   const std::uint64_t mask = digits - 1;
-  const std::size_t chunks = num_threads > 1 && n >= 65536 ? num_threads : 1;
+  const std::size_t chunks = num_threads > 1 && n >= 8192 ? num_threads : 1;
   const std::size_t chunk_size = (n + chunks - 1) / chunks;
   const auto chunk_begin = [&](std::size_t c) { return std::min(n, c * chunk_size); };
   std::vector<std::pair<std::uint64_t, pcl::index_t>> buffer(n);
