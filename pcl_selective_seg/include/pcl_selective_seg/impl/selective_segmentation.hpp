@@ -215,14 +215,41 @@ SelectiveSegmentation<PointT>::buildOctree()
   const std::size_t num_vertices = tri.vertex_positions.size();
   auto vertices = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
   vertices->resize(num_vertices);
-  Eigen::Array3f lo = Eigen::Array3f::Constant(std::numeric_limits<float>::max());
-  Eigen::Array3f hi = -lo;
-  for (std::size_t v = 0; v < num_vertices; ++v) {
-    (*vertices)[v].getVector3fMap() = tri.vertex_positions[v];
-    if (vertex_normals_[v].allFinite()) {
-      lo = lo.min(tri.vertex_positions[v].array());
-      hi = hi.max(tri.vertex_positions[v].array());
+  // The box of the vertices with a normal: per-thread minima and maxima, combined (the
+  // same for any thread count).
+  const int threads = num_vertices >= 16384 ? numThreads() : 1;
+  const float big = std::numeric_limits<float>::max();
+  std::vector<Eigen::Array3f> los(static_cast<std::size_t>(threads),
+                                  Eigen::Array3f::Constant(big));
+  std::vector<Eigen::Array3f> his(static_cast<std::size_t>(threads),
+                                  Eigen::Array3f::Constant(-big));
+#ifdef _OPENMP
+#pragma omp parallel num_threads(threads)
+#endif
+  {
+#ifdef _OPENMP
+    const auto mine = static_cast<std::size_t>(omp_get_thread_num());
+#else
+    const std::size_t mine = 0;
+#endif
+    Eigen::Array3f my_lo = los[mine], my_hi = his[mine]; // no shared cache line
+#ifdef _OPENMP
+#pragma omp for schedule(static)
+#endif
+    for (std::ptrdiff_t v = 0; v < static_cast<std::ptrdiff_t>(num_vertices); ++v) {
+      (*vertices)[v].getVector3fMap() = tri.vertex_positions[v];
+      if (vertex_normals_[v].allFinite()) {
+        my_lo = my_lo.min(tri.vertex_positions[v].array());
+        my_hi = my_hi.max(tri.vertex_positions[v].array());
+      }
     }
+    los[mine] = my_lo;
+    his[mine] = my_hi;
+  }
+  Eigen::Array3f lo = los[0], hi = his[0];
+  for (std::size_t t = 1; t < los.size(); ++t) {
+    lo = lo.min(los[t]);
+    hi = hi.max(his[t]);
   }
   // The finest voxel: the parameter, or a multiple of the point spacing, but never so
   // small that the tree would exceed its maximum depth.
@@ -263,7 +290,12 @@ SelectiveSegmentation<PointT>::buildOctree()
   vertex_leaf_.assign(num_vertices, -1);
   const auto& leaves = octree_->getAdaptiveLeaves();
   const auto& ordered = octree_->getOrderedIndices();
-  for (std::size_t l = 0; l < leaves.size(); ++l)
+  // Each vertex is in one leaf at most: the leaves can be split among the threads.
+  const auto num_leaves = static_cast<std::ptrdiff_t>(leaves.size());
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(threads) schedule(static)
+#endif
+  for (std::ptrdiff_t l = 0; l < num_leaves; ++l)
     for (std::size_t k = leaves[l].begin; k < leaves[l].end; ++k)
       vertex_leaf_[ordered[k]] = static_cast<pcl::index_t>(l);
   return true;
