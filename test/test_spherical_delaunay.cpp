@@ -19,7 +19,6 @@
 #include <cmath>
 #include <limits>
 #include <map>
-#include <numeric>
 #include <random>
 #include <set>
 #include <vector>
@@ -357,30 +356,6 @@ TEST(RadixSort, StableAndThreadIndependent)
       pcl::selective_seg::detail::radixSortByKey(sorted, bits, threads);
       EXPECT_TRUE(sorted == expected);
     }
-  }
-}
-
-// Seeds and segments are ranked by size, largest first, ties by index.
-TEST(RadixSort, OrderBySizeDescendingIsTheStableSortsOrder)
-{
-  std::mt19937_64 rng(5);
-  EXPECT_TRUE(pcl::selective_seg::detail::orderBySizeDescending(
-                  std::vector<std::size_t>{})
-                  .empty());
-  for (const std::uint64_t range : {1ull, 3ull, 1000ull, 1ull << 40}) {
-    SCOPED_TRACE(range);
-    std::vector<std::uint64_t> sizes(20000);
-    for (auto& s : sizes)
-      s = rng() % range;
-    sizes[7] = range; // one largest
-    std::vector<pcl::index_t> expected(sizes.size());
-    std::iota(expected.begin(), expected.end(), 0);
-    std::stable_sort(expected.begin(), expected.end(), [&](pcl::index_t a, pcl::index_t b) {
-      return sizes[a] > sizes[b];
-    });
-    for (const unsigned threads : {1u, 2u})
-      EXPECT_EQ(pcl::selective_seg::detail::orderBySizeDescending(sizes, threads),
-                expected);
   }
 }
 

@@ -8,7 +8,6 @@
 #include <pcl_selective_seg/spherical_delaunay.h>
 
 #include "incidence_build.h"
-#include <pcl_selective_seg/impl/radix_sort.hpp>
 
 #include <algorithm>
 #include <array>
@@ -90,10 +89,21 @@ std::vector<pcl::index_t>
 seedOrder(const std::vector<pcl::index_t>& vertex_leaf, std::size_t num_leaves)
 {
   std::vector<std::uint32_t> size(num_leaves, 0);
+  std::uint32_t largest = 0;
   for (const auto l : vertex_leaf)
     if (l >= 0)
-      ++size[l];
-  return detail::orderBySizeDescending(size);
+      largest = std::max(largest, ++size[l]);
+  // A counting sort by size, largest first; leaves of one size in increasing order (the
+  // order of a stable sort of 0, 1, ... by decreasing size).
+  std::vector<std::size_t> first(static_cast<std::size_t>(largest) + 2, 0);
+  for (const auto n : size)
+    ++first[largest - n + 1];
+  for (std::size_t k = 1; k < first.size(); ++k)
+    first[k] += first[k - 1];
+  std::vector<pcl::index_t> order(num_leaves);
+  for (std::size_t l = 0; l < num_leaves; ++l)
+    order[first[largest - size[l]]++] = static_cast<pcl::index_t>(l);
+  return order;
 }
 
 /** A triangle listed under a leaf, with the leaves of its vertices (-1: none) kept

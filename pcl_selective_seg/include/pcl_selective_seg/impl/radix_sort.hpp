@@ -84,25 +84,6 @@ radixSortByKey(std::vector<std::pair<std::uint64_t, pcl::index_t>>& entries,
   }
 }
 
-/** \brief The indices 0..n-1 of \a sizes, largest size first and equal sizes in
- * increasing index order: the order of a stable sort by decreasing size, in linear
- * time (radixSortByKey() on largest - size). */
-template <typename Size>
-std::vector<pcl::index_t>
-orderBySizeDescending(const std::vector<Size>& sizes, unsigned int num_threads = 1)
-{
-  const std::uint64_t largest =
-      sizes.empty() ? 0 : static_cast<std::uint64_t>(*std::max_element(sizes.begin(), sizes.end()));
-  std::vector<std::pair<std::uint64_t, pcl::index_t>> entries(sizes.size());
-  for (std::size_t i = 0; i < sizes.size(); ++i)
-    entries[i] = {largest - static_cast<std::uint64_t>(sizes[i]), static_cast<pcl::index_t>(i)};
-  radixSortByKey(entries, bitWidth(largest), num_threads);
-  std::vector<pcl::index_t> order(sizes.size());
-  for (std::size_t i = 0; i < entries.size(); ++i)
-    order[i] = entries[i].second;
-  return order;
-}
-
 } // namespace detail
 } // namespace selective_seg
 } // namespace pcl

@@ -6,7 +6,6 @@
 
 #pragma once
 
-#include <pcl_selective_seg/impl/radix_sort.hpp>
 #include <pcl_selective_seg/impl/spherical_delaunay.hpp>
 #include <pcl_selective_seg/region_merging.h>
 #include <pcl_selective_seg/selective_segmentation.h>
@@ -338,7 +337,11 @@ SelectiveSegmentation<PointT>::rankSegments(
     for (std::size_t k = 0; k < num_segments; ++k)
       sizes[k] += counts[t][k];
   // Largest first; ties keep the (data-determined) creation order.
-  const std::vector<pcl::index_t> order = detail::orderBySizeDescending(sizes);
+  std::vector<std::size_t> order(num_segments);
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return sizes[a] > sizes[b];
+  });
   segment_label.assign(num_segments, 0);
   result_.segments.resize(num_segments);
   const Eigen::Matrix3f to_cloud = sensorToCloud();
