@@ -13,6 +13,8 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <memory>
+#include <type_traits>
 #include <vector>
 
 namespace pcl {
@@ -21,15 +23,23 @@ namespace detail {
 
 /** \brief An array stored in blocks of 4,096 entries: a large temporary array that can
  * reuse the memory earlier stages freed to the allocator (one block of it is below
- * malloc's mapping threshold) instead of mapping fresh pages on top of it. */
+ * malloc's mapping threshold) instead of mapping fresh pages on top of it. The entries
+ * are left uninitialized (T is trivial): the caller writes every one, and filling the
+ * blocks first was a sequential pass over the whole array. */
 template <typename T>
 class BlockArray {
+  static_assert(std::is_trivially_default_constructible<T>::value &&
+                    std::is_trivially_destructible<T>::value,
+                "BlockArray leaves its entries uninitialized");
+
 public:
+  /** Blocks for \a size entries (the previous ones are freed), not initialized. */
   void resize(std::size_t size)
   {
+    blocks_.clear();
     blocks_.resize((size + kMask) >> kShift);
     for (std::size_t b = 0; b < blocks_.size(); ++b)
-      blocks_[b].resize(std::min<std::size_t>(kMask + 1, size - (b << kShift)));
+      blocks_[b].reset(new T[std::min<std::size_t>(kMask + 1, size - (b << kShift))]);
   }
   T& operator[](std::size_t i) { return blocks_[i >> kShift][i & kMask]; }
   const T& operator[](std::size_t i) const { return blocks_[i >> kShift][i & kMask]; }
@@ -37,7 +47,7 @@ public:
 private:
   static constexpr std::size_t kShift = 12;
   static constexpr std::size_t kMask = (std::size_t{1} << kShift) - 1;
-  std::vector<std::vector<T>> blocks_;
+  std::vector<std::unique_ptr<T[]>> blocks_;
 };
 
 /** \brief Buckets by a counting sort: emit(item, f) calls f(group, value) for each entry
