@@ -14,6 +14,7 @@ trap 'rm -rf "$work"' EXIT
 
 load_before=$(cut -d' ' -f1-3 /proc/loadavg)
 SELSEG_DATA="$shared" "$build/test/selseg_benchmark" \
+  --benchmark_enable_random_interleaving=true \
   --benchmark_out="$work/benchmark.json" --benchmark_out_format=json
 load_after=$(cut -d' ' -f1-3 /proc/loadavg)
 # SELSEG_BENCHMARK_JSON=FILE keeps a copy of the raw results.
