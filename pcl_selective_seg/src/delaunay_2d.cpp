@@ -62,10 +62,10 @@ reportDuplicate(const std::vector<QuantizedPoint>& points,
 }
 
 bool
-allCollinear(const std::vector<QuantizedPoint>& points)
+allCollinear(const QuantizedPoint* first, std::size_t count)
 {
-  for (std::size_t i = 2; i < points.size(); ++i)
-    if (orientation(points[0], points[1], points[i]) != 0)
+  for (std::size_t i = 2; i < count; ++i)
+    if (orientation(first[0], first[1], first[i]) != 0)
       return false;
   return true;
 }

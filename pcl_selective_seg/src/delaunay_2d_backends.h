@@ -11,8 +11,11 @@
 
 #include <pcl_selective_seg/delaunay_2d.h>
 
+#include <algorithm>
+#include <cstddef>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace pcl {
@@ -81,8 +84,48 @@ void reportDuplicate(const std::vector<QuantizedPoint>& points,
                      const QuantizedPoint& position,
                      std::string* error);
 
-/** \brief Whether all points lie on one line (true for fewer than three points). */
-bool allCollinear(const std::vector<QuantizedPoint>& points);
+/** \brief Whether the \a count points from \a first lie on one line (true for fewer
+ * than three points). */
+bool allCollinear(const QuantizedPoint* first, std::size_t count);
+
+/** \brief The same for all of \a points. */
+inline bool
+allCollinear(const std::vector<QuantizedPoint>& points)
+{
+  return allCollinear(points.data(), points.size());
+}
+
+/** \brief The key of the undirected edge {a, b} over point ids. */
+inline std::uint64_t
+undirectedEdgeKey(index_t a, index_t b)
+{
+  if (a > b)
+    std::swap(a, b);
+  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) |
+         static_cast<std::uint32_t>(b);
+}
+
+/** \brief Sorts edge records (anything with a \c key member) by key. */
+template <typename Edge>
+void
+sortByKey(std::vector<Edge>& edges)
+{
+  std::sort(edges.begin(), edges.end(), [](const Edge& a, const Edge& b) {
+    return a.key < b.key;
+  });
+}
+
+/** \brief The record with \a key in \a edges sorted by sortByKey(), or null. */
+template <typename Edge>
+Edge*
+findByKey(std::vector<Edge>& edges, std::uint64_t key)
+{
+  const auto it = std::lower_bound(
+      edges.begin(), edges.end(), key, [](const Edge& e, std::uint64_t k) {
+        return e.key < k;
+      });
+  return it != edges.end() && it->key == key ? &*it : nullptr;
+}
 
 /** \brief Rotates each triangle so that its smallest id comes first, then sorts the
  * list (linear time: a counting sort on the first id, then small buckets). Slots whose

@@ -31,10 +31,14 @@ namespace selective_seg {
 
 namespace {
 
+using detail::allCollinear;
+using detail::findByKey;
 using detail::inCircle;
 using detail::Int128;
 using detail::kNone;
 using detail::orientation;
+using detail::sortByKey;
+using detail::undirectedEdgeKey;
 
 // ------------------------------------------------------------------ the order
 
@@ -936,16 +940,6 @@ circumdiskWithin(const QuantizedPoint& a,
          (!has_left || clear(static_cast<double>(std::int64_t{a[0]} - left), -1.0));
 }
 
-/** Undirected edge key over point ids. */
-inline std::uint64_t
-undirectedKey(index_t a, index_t b)
-{
-  if (a > b)
-    std::swap(a, b);
-  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) |
-         static_cast<std::uint32_t>(b);
-}
-
 /** An edge of a kept triangle whose other side is re-triangulated, or on a slab's
  * hull. */
 struct SeamEdge {
@@ -1025,7 +1019,7 @@ triangulateSlab(const std::vector<QuantizedPoint>& points,
       }
       const index_t from = slab.first + tri[(i + 1) % 3];
       const index_t to = slab.first + tri[(i + 2) % 3];
-      slab.seam.push_back({undirectedKey(from, to), from, t, kNone, i, u == kNone});
+      slab.seam.push_back({undirectedEdgeKey(from, to), from, t, kNone, i, u == kNone});
       if (u == kNone) {
         slab.local.push_back(from);
         slab.local.push_back(to);
@@ -1081,11 +1075,7 @@ triangulateSortedInSlabs(const std::vector<QuantizedPoint>& points,
       ++end;
     if (end - begin < 3)
       return false;
-    const QuantizedPoint* p = points.data() + begin;
-    bool collinear = true;
-    for (index_t i = 2; i < end - begin && collinear; ++i)
-      collinear = orientation(p[0], p[1], p[i]) == 0;
-    if (collinear)
+    if (allCollinear(points.data() + begin, static_cast<std::size_t>(end - begin)))
       return false;
     slabs[s].first = begin;
     slabs[s].count = end - begin;
@@ -1133,16 +1123,8 @@ triangulateSortedInSlabs(const std::vector<QuantizedPoint>& points,
   }
   std::sort(local.begin(), local.end());
   local.erase(std::unique(local.begin(), local.end()), local.end());
-  std::sort(seam.begin(), seam.end(), [](const SeamEdge& a, const SeamEdge& b) {
-    return a.key < b.key;
-  });
-  const auto findSeam = [&seam](std::uint64_t key) -> SeamEdge* {
-    const auto it = std::lower_bound(
-        seam.begin(), seam.end(), key, [](const SeamEdge& e, std::uint64_t k) {
-          return e.key < k;
-        });
-    return it != seam.end() && it->key == key ? &*it : nullptr;
-  };
+  sortByKey(seam);
+  const auto findSeam = [&seam](std::uint64_t key) { return findByKey(seam, key); };
 
   // DT(L), and the flood from the seam into R.
   std::vector<QuantizedPoint> local_points(local.size());
@@ -1163,7 +1145,7 @@ triangulateSortedInSlabs(const std::vector<QuantizedPoint>& points,
   std::vector<index_t> stack;
   for (index_t t = 0; t < static_cast<index_t>(local_tris.size()); ++t)
     for (int i = 0; i < 3 && slot_of[t] == kNone; ++i) {
-      const SeamEdge* e = findSeam(undirectedKey(edgeFrom(t, i), edgeTo(t, i)));
+      const SeamEdge* e = findSeam(undirectedEdgeKey(edgeFrom(t, i), edgeTo(t, i)));
       // R lies left of to -> from, the kept triangle's edge reversed.
       if (e && e->from == edgeTo(t, i)) {
         slot_of[t] = 0;
@@ -1176,7 +1158,7 @@ triangulateSortedInSlabs(const std::vector<QuantizedPoint>& points,
     for (int i = 0; i < 3; ++i) {
       const index_t u = local_nbrs[t][i];
       if (u == kNone || slot_of[u] != kNone ||
-          findSeam(undirectedKey(edgeFrom(t, i), edgeTo(t, i))))
+          findSeam(undirectedEdgeKey(edgeFrom(t, i), edgeTo(t, i))))
         continue;
       slot_of[u] = 0;
       stack.push_back(u);
@@ -1210,7 +1192,7 @@ triangulateSortedInSlabs(const std::vector<QuantizedPoint>& points,
         neighbours[id][i] = slot_of[u];
         continue;
       }
-      SeamEdge* e = findSeam(undirectedKey(edgeFrom(t, i), edgeTo(t, i)));
+      SeamEdge* e = findSeam(undirectedEdgeKey(edgeFrom(t, i), edgeTo(t, i)));
       if (e == nullptr) {
         if (u != kNone) // the flood crossed every other edge
           return false;

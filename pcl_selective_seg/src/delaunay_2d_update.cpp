@@ -33,16 +33,7 @@ namespace {
 
 using detail::inCircle;
 using detail::orientation;
-
-/** Undirected edge key over new point ids. */
-inline std::uint64_t
-edgeKey(pcl::index_t a, pcl::index_t b)
-{
-  if (a > b)
-    std::swap(a, b);
-  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) |
-         static_cast<std::uint32_t>(b);
-}
+using detail::undirectedEdgeKey;
 
 /** A hull edge: triangle and the local index of the vertex opposite the edge. The edge
  * runs from triangle[(i + 1) % 3] to triangle[(i + 2) % 3], the interior on its left.
@@ -259,13 +250,13 @@ Inserter::run(const std::vector<QuantizedPoint>& q,
       for (const pcl::index_t v : t_[u]) // one ring more around the region
         local.push_back(remap[v]);
       boundary.push_back(
-          {edgeKey(remap[t_[t][(i + 1) % 3]], remap[t_[t][(i + 2) % 3]]), u});
+          {undirectedEdgeKey(remap[t_[t][(i + 1) % 3]], remap[t_[t][(i + 2) % 3]]), u});
     }
   }
   for (const HullEdge& h : seen_hull_)
     if (!replaced_[h.triangle]) {
       const Triangle& tri = t_[h.triangle];
-      boundary.push_back({edgeKey(remap[tri[(h.opposite + 1) % 3]],
+      boundary.push_back({undirectedEdgeKey(remap[tri[(h.opposite + 1) % 3]],
                                   remap[tri[(h.opposite + 2) % 3]]),
                           h.triangle});
     }
@@ -274,9 +265,7 @@ Inserter::run(const std::vector<QuantizedPoint>& q,
   local.insert(local.end(), info.inserted_points.begin(), info.inserted_points.end());
   std::sort(local.begin(), local.end());
   local.erase(std::unique(local.begin(), local.end()), local.end());
-  std::sort(boundary.begin(), boundary.end(), [](const Boundary& a, const Boundary& b) {
-    return a.key < b.key;
-  });
+  detail::sortByKey(boundary);
   boundary.erase(std::unique(boundary.begin(),
                              boundary.end(),
                              [](const Boundary& a, const Boundary& b) {
@@ -284,11 +273,7 @@ Inserter::run(const std::vector<QuantizedPoint>& q,
                              }),
                  boundary.end());
   const auto findBoundary = [&](std::uint64_t key) -> const Boundary* {
-    const auto it = std::lower_bound(
-        boundary.begin(), boundary.end(), key, [](const Boundary& b, std::uint64_t k) {
-          return b.key < k;
-        });
-    return it != boundary.end() && it->key == key ? &*it : nullptr;
+    return detail::findByKey(boundary, key);
   };
 
   // 4. The local triangulation (its points are sorted: the sweep's fast path), and the
@@ -322,7 +307,7 @@ Inserter::run(const std::vector<QuantizedPoint>& q,
       const pcl::index_t u = local_nbrs[t][i];
       if (u < 0 || in_region[u])
         continue;
-      if (findBoundary(edgeKey(local[local_tris[t][(i + 1) % 3]],
+      if (findBoundary(undirectedEdgeKey(local[local_tris[t][(i + 1) % 3]],
                                local[local_tris[t][(i + 2) % 3]])))
         continue;
       in_region[u] = 1;
@@ -386,7 +371,7 @@ Inserter::run(const std::vector<QuantizedPoint>& q,
       const pcl::index_t u = local_nbrs[lt][i];
       if (u >= 0 && in_region[u])
         continue;
-      const std::uint64_t key = edgeKey(fresh[j][(i + 1) % 3], fresh[j][(i + 2) % 3]);
+      const std::uint64_t key = undirectedEdgeKey(fresh[j][(i + 1) % 3], fresh[j][(i + 2) % 3]);
       if (const Boundary* b = findBoundary(key)) {
         const auto index = static_cast<std::size_t>(b - boundary.data());
         if (matched[index]++) {
@@ -416,7 +401,7 @@ Inserter::run(const std::vector<QuantizedPoint>& q,
         continue;
       }
       const Triangle& tri = out_triangles[id];
-      const auto it = fresh_edges.find(edgeKey(tri[(i + 1) % 3], tri[(i + 2) % 3]));
+      const auto it = fresh_edges.find(undirectedEdgeKey(tri[(i + 1) % 3], tri[(i + 2) % 3]));
       if (it != fresh_edges.end())
         out_neighbours[id][i] = it->second;
       else
@@ -433,7 +418,7 @@ Inserter::run(const std::vector<QuantizedPoint>& q,
         continue;
       }
       const Boundary* b =
-          findBoundary(edgeKey(fresh[j][(i + 1) % 3], fresh[j][(i + 2) % 3]));
+          findBoundary(undirectedEdgeKey(fresh[j][(i + 1) % 3], fresh[j][(i + 2) % 3]));
       if (b)
         out_neighbours[id][i] = info.old_to_new_triangle[b->kept];
       else
