@@ -78,7 +78,8 @@ canonicalize(std::vector<Triangle>& triangles,
 {
   const auto num_slots = static_cast<std::ptrdiff_t>(triangles.size());
   const int threads = std::max(1, num_threads);
-  const bool parallel = threads > 1 && num_slots >= 16384;
+  const bool parallel =
+      threads > 1 && static_cast<std::size_t>(num_slots) >= kMinParallelItems;
   // Each triangle rotated so that its smallest id comes first; rotating the corners
   // rotates the neighbours opposite them the same way. Removed slots stay as they are.
 #ifdef _OPENMP

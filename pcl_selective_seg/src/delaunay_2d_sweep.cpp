@@ -736,7 +736,9 @@ SweepTriangulation::repairAndClassify()
   // alone reads and writes the pair's states, so the triangles can be split among
   // threads); the illegal ones listed in increasing order, whatever the thread count.
   const index_t num_triangles = num_triangles_;
-  const int threads = num_triangles >= 16384 ? num_threads_ : 1;
+  const bool parallel =
+      static_cast<std::size_t>(num_triangles) >= detail::kMinParallelItems;
+  const int threads = parallel ? num_threads_ : 1;
   std::vector<std::vector<index_t>> found(static_cast<std::size_t>(threads));
 #ifdef _OPENMP
 #pragma omp parallel num_threads(threads)
@@ -826,7 +828,7 @@ SweepTriangulation::neighbours(Triangle* out) const
   const index_t num_triangles = num_triangles_;
 #ifdef _OPENMP
 #pragma omp parallel for num_threads(num_threads_) schedule(static) \
-    if (num_triangles >= 16384)
+    if (static_cast<std::size_t>(num_triangles) >= detail::kMinParallelItems)
 #endif
   for (index_t t = 0; t < num_triangles; ++t) {
     out[t] = Triangle{kNone, kNone, kNone};

@@ -70,8 +70,8 @@ placeInBuckets(std::size_t num_items,
                Prepare prepare,
                Store store)
 {
-  const std::size_t chunks =
-      num_threads > 1 && num_items >= 16384 ? static_cast<std::size_t>(num_threads) : 1;
+  const bool parallel = num_threads > 1 && num_items >= kMinParallelItems;
+  const std::size_t chunks = parallel ? static_cast<std::size_t>(num_threads) : 1;
   const std::size_t chunk_size = (num_items + chunks - 1) / chunks;
   const auto chunk_begin = [&](std::size_t c) {
     return std::min(num_items, c * chunk_size);

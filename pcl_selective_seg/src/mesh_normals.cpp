@@ -235,7 +235,7 @@ scatterVertexNormals(std::size_t num_vertices,
                      int num_threads)
 {
   const std::size_t num_triangles = triangles.size();
-  const bool parallel = num_threads > 1 && num_triangles >= 16384;
+  const bool parallel = num_threads > 1 && num_triangles >= detail::kMinParallelItems;
   if (parallel && !neighbours)
     return false; // the gather runs on all threads
   const auto runs = static_cast<std::size_t>(parallel ? num_threads : 1);
@@ -570,7 +570,7 @@ medianEdgeLength(const Vector3fVector& positions,
   std::vector<double> squares(3 * static_cast<std::size_t>(sampled));
 #ifdef _OPENMP
 #pragma omp parallel for num_threads(threads(num_threads)) schedule(static) \
-    if (sampled >= 16384)
+    if (static_cast<std::size_t>(sampled) >= detail::kMinParallelItems)
 #endif
   for (std::ptrdiff_t j = 0; j < sampled; ++j) {
     const Triangle& t = triangles[static_cast<std::size_t>(j) * stride];

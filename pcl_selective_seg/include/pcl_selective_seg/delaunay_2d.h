@@ -10,6 +10,7 @@
 #include <pcl/types.h>
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -29,6 +30,14 @@ using QuantizedPoint = std::array<std::int32_t, 2>;
  * Differences then fit in 28 bits and the in-circle determinant in a 128-bit integer.
  */
 constexpr std::int32_t kMaxDelaunayCoordinate = 1 << 26;
+
+namespace detail {
+/** \brief The fewest items (triangles, vertices, sampled edges, list items) a loop of
+ * the pipeline splits among threads; below it one thread is as fast. Measured on door
+ * scans of 5k-46k points (docs/performance_notes.md, round 5). No result depends on
+ * it. */
+constexpr std::size_t kMinParallelItems = 16384;
+} // namespace detail
 
 /** \brief A triangle as three vertex ids, counter-clockwise in the 2-D plane. */
 using Triangle = std::array<pcl::index_t, 3>;

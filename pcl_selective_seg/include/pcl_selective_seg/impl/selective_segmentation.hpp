@@ -217,7 +217,7 @@ SelectiveSegmentation<PointT>::buildOctree()
   vertices->resize(num_vertices);
   // The box of the vertices with a normal: per-thread minima and maxima, combined (the
   // same for any thread count).
-  const int threads = num_vertices >= 16384 ? numThreads() : 1;
+  const int threads = num_vertices >= detail::kMinParallelItems ? numThreads() : 1;
   const float big = std::numeric_limits<float>::max();
   std::vector<Eigen::Array3f> los(static_cast<std::size_t>(threads),
                                   Eigen::Array3f::Constant(big));
