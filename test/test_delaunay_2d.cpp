@@ -964,12 +964,13 @@ TEST(SweepMatchesBoost, LinesAndCurves)
   EXPECT_TRUE(sweepMatchesBoost(opening_up));
 }
 
-// The sweep on several threads triangulates slabs of the points (split between distinct
-// x) and re-triangulates the triangles whose circumdisks reach a neighbouring slab. Inputs
-// that stress the stitching: every split inside a run of equal x, lattices (co-circular
-// groups across the seams), flat strips (most circumdisks cross the seams), far-apart
-// clusters (wide gaps between the slabs' hulls), a collinear slab (no triangulation of
-// its own: the sweep runs in one piece), and slabs of very different sizes.
+// The sweep on several threads triangulates slabs of the points (split between
+// distinct x) and re-triangulates the triangles whose circumdisks reach a neighbouring
+// slab. Inputs that stress the stitching: every split inside a run of equal x, lattices
+// (co-circular groups across the seams), flat strips (most circumdisks cross the
+// seams), far-apart clusters (wide gaps between the slabs' hulls), a collinear slab (no
+// triangulation of its own: the sweep runs in one piece), and slabs of very different
+// sizes.
 /** Whether the sweep's slab path, with 1 to 7 slabs, gives Boost's triangles and their
  * adjacency; \a applies: whether it is expected to apply (no collinear slab). */
 ::testing::AssertionResult
@@ -1046,9 +1047,11 @@ TEST(SweepMatchesBoost, SlabsAreStitchedExactly)
     const std::int32_t centre = (k % 3) * 20000000 - 20000000;
     clusters.push_back({centre + static_cast<std::int32_t>(rng() % 2001) - 1000,
                         static_cast<std::int32_t>(rng() % 2001) - 1000});
-    column.push_back(k % 2 ? QuantizedPoint{0, k}
-                           : QuantizedPoint{1 + static_cast<std::int32_t>(rng() % 30000),
-                                            static_cast<std::int32_t>(rng() % 30000)});
+    if (k % 2)
+      column.push_back({0, k});
+    else
+      column.push_back({1 + static_cast<std::int32_t>(rng() % 30000),
+                        static_cast<std::int32_t>(rng() % 30000)});
   }
   EXPECT_TRUE(sweepMatchesBoost(distinctShuffled(clusters, rng)));
   EXPECT_TRUE(sweepMatchesBoost(distinctShuffled(column, rng)));

@@ -181,9 +181,9 @@ bool delaunaySweep(const std::vector<QuantizedPoint>& points,
  * split into slabs between distinct x, each triangulated by the sweep, the triangles
  * whose circumdisks reach a neighbouring slab re-triangulated and stitched (see
  * delaunay_2d_sweep.cpp). Gives the canonical triangles and their adjacency, or false
- * (and nothing) where that path does not apply (a collinear slab, a slab over the sweep's
- * flip budget, unsorted points) or a check of the stitching fails; delaunaySweep() then
- * triangulates in one piece. For tests. */
+ * (and nothing) where that path does not apply (a collinear slab, a slab over the
+ * sweep's flip budget, unsorted points) or a check of the stitching fails;
+ * delaunaySweep() then triangulates in one piece. For tests. */
 bool delaunaySweepInSlabs(const std::vector<QuantizedPoint>& points,
                           int num_slabs,
                           std::vector<Triangle>& triangles,

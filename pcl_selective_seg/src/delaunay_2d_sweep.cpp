@@ -913,7 +913,8 @@ triangulateSorted(const std::vector<QuantizedPoint>& points,
  * With b, c relative to a, the circumcentre is u = (nx, ny) / d with d = 2 orient(a, b,
  * c) > 0, nx = cy |b|^2 - by |c|^2, ny = bx |c|^2 - cx |b|^2 (exact in int64 / int128).
  * The disk stays left of a.x + s (s > 0) iff ux + |u| < s, iff uy^2 + 2 s ux < s^2,
- * iff s^2 d^2 - ny^2 - 2 s nx d > 0; right of a.x - s iff s^2 d^2 - ny^2 + 2 s nx d > 0.
+ * iff s^2 d^2 - ny^2 - 2 s nx d > 0;
+ * right of a.x - s iff s^2 d^2 - ny^2 + 2 s nx d > 0.
  * These are evaluated in double from correctly rounded nx, ny, d: each of the three
  * terms carries a relative error below 2^-50, so a value above 10^-12 times the sum of
  * their magnitudes has the right sign. */
@@ -967,9 +968,9 @@ struct Slab {
 
 /** Triangulates a slab (sweep, canonical fans, adjacency) into its slots of \a
  * triangles and \a neighbours, in global ids. Keeps the triangles whose closed
- * circumdisk stays inside the slab's x range (Delaunay in the union too) and removes the
- * others (kNone corners), listing their points, the slab's hull points and the edges of
- * the kept triangles towards them or the hull. */
+ * circumdisk stays inside the slab's x range (Delaunay in the union too) and removes
+ * the others (kNone corners), listing their points, the slab's hull points and the
+ * edges of the kept triangles towards them or the hull. */
 void
 triangulateSlab(const std::vector<QuantizedPoint>& points,
                 Slab& slab,
@@ -1136,8 +1137,12 @@ triangulateSortedInSlabs(const std::vector<QuantizedPoint>& points,
   if (!detail::delaunaySweep(local_points, local_tris, &local_nbrs, nullptr) ||
       local_tris.empty())
     return false;
-  const auto edgeFrom = [&](index_t t, int i) { return local[local_tris[t][(i + 1) % 3]]; };
-  const auto edgeTo = [&](index_t t, int i) { return local[local_tris[t][(i + 2) % 3]]; };
+  const auto edgeFrom = [&](index_t t, int i) {
+    return local[local_tris[t][(i + 1) % 3]];
+  };
+  const auto edgeTo = [&](index_t t, int i) {
+    return local[local_tris[t][(i + 2) % 3]];
+  };
   std::size_t num_kept = 0;
   for (const Slab& slab : slabs)
     num_kept += static_cast<std::size_t>(slab.capacity) - slab.free_slots.size();
@@ -1171,7 +1176,8 @@ triangulateSortedInSlabs(const std::vector<QuantizedPoint>& points,
   for (index_t& slot : slot_of) {
     if (slot == kNone)
       continue;
-    while (next_slab < slabs.size() && next_free == slabs[next_slab].free_slots.size()) {
+    while (next_slab < slabs.size() &&
+           next_free == slabs[next_slab].free_slots.size()) {
       ++next_slab;
       next_free = 0;
     }

@@ -371,7 +371,8 @@ Inserter::run(const std::vector<QuantizedPoint>& q,
       const pcl::index_t u = local_nbrs[lt][i];
       if (u >= 0 && in_region[u])
         continue;
-      const std::uint64_t key = undirectedEdgeKey(fresh[j][(i + 1) % 3], fresh[j][(i + 2) % 3]);
+      const std::uint64_t key =
+          undirectedEdgeKey(fresh[j][(i + 1) % 3], fresh[j][(i + 2) % 3]);
       if (const Boundary* b = findBoundary(key)) {
         const auto index = static_cast<std::size_t>(b - boundary.data());
         if (matched[index]++) {
@@ -401,7 +402,8 @@ Inserter::run(const std::vector<QuantizedPoint>& q,
         continue;
       }
       const Triangle& tri = out_triangles[id];
-      const auto it = fresh_edges.find(undirectedEdgeKey(tri[(i + 1) % 3], tri[(i + 2) % 3]));
+      const auto it =
+          fresh_edges.find(undirectedEdgeKey(tri[(i + 1) % 3], tri[(i + 2) % 3]));
       if (it != fresh_edges.end())
         out_neighbours[id][i] = it->second;
       else

@@ -208,8 +208,10 @@ private:
       for (auto i = adjacency_.offsets[leaf]; i < end; ++i) {
         // The triangles' normals are scattered: ask for one a few entries ahead (a
         // hint; no effect on the values).
-        if (i + 8 < end && adjacency_.entries[i + 8].triangle >= 0)
-          __builtin_prefetch(&(*in_.triangle_normals)[adjacency_.entries[i + 8].triangle]);
+        if (i + 8 < end && adjacency_.entries[i + 8].triangle >= 0) {
+          const pcl::index_t ahead = adjacency_.entries[i + 8].triangle;
+          __builtin_prefetch(&(*in_.triangle_normals)[ahead]);
+        }
         visitTriangle(adjacency_.entries[i], k, segment, leaf_segment);
       }
     }

@@ -321,7 +321,8 @@ SelectiveSegmentation<PointT>::rankSegments(
 #endif
   {
 #ifdef _OPENMP
-    std::vector<std::size_t>& mine = counts[static_cast<std::size_t>(omp_get_thread_num())];
+    std::vector<std::size_t>& mine =
+        counts[static_cast<std::size_t>(omp_get_thread_num())];
 #pragma omp for schedule(static)
 #else
     std::vector<std::size_t>& mine = counts[0];
