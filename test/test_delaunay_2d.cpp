@@ -1029,7 +1029,7 @@ TEST(SweepMatchesBoost, SlabsAreStitchedExactly)
     }
   }
   EXPECT_GT(applied, 2000); // of 4000: most inputs have no collinear slab
-  // Through delaunay2d() on several threads (slabs of at least 8192 points):
+  // Through delaunay2d() on several threads (slabs of at least 2,048 points):
   // Columns of 200 points with equal x: the slab ends move to the next column.
   EXPECT_TRUE(sweepMatchesBoost(gridPoints(150, 200, -3000, -5000, 40, 50)));
   // Axis-aligned and tilted lattices: co-circular squares at every seam.

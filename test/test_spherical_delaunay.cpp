@@ -337,24 +337,26 @@ TEST(RadixSort, StableAndThreadIndependent)
 {
   std::mt19937_64 rng(11);
   // Sizes on both sides of the threaded path's threshold (8,192 entries).
-  for (const std::size_t size : {8191u, 8192u, 10001u, 150000u})
-  for (const int bits : {1, 7, 22, 33, 50, 64}) {
-    SCOPED_TRACE(bits);
+  for (const std::size_t size : {8191u, 8192u, 10001u, 150000u}) {
     SCOPED_TRACE(size);
-    std::vector<std::pair<std::uint64_t, pcl::index_t>> entries(size);
-    const std::uint64_t mask = bits == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << bits) - 1;
-    for (std::size_t i = 0; i < entries.size(); ++i) // many equal keys
-      entries[i] = {(rng() % 5000) * 0x9e3779b97f4a7c15ull & mask,
-                    static_cast<pcl::index_t>(i)};
-    auto expected = entries;
-    std::stable_sort(expected.begin(), expected.end(), [](const auto& a, const auto& b) {
-      return a.first < b.first;
-    });
-    for (const unsigned threads : {1u, 2u, 3u}) {
-      SCOPED_TRACE(threads);
-      auto sorted = entries;
-      pcl::selective_seg::detail::radixSortByKey(sorted, bits, threads);
-      EXPECT_TRUE(sorted == expected);
+    for (const int bits : {1, 7, 22, 33, 50, 64}) {
+      SCOPED_TRACE(bits);
+      std::vector<std::pair<std::uint64_t, pcl::index_t>> entries(size);
+      const std::uint64_t mask =
+          bits == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << bits) - 1;
+      for (std::size_t i = 0; i < entries.size(); ++i) // many equal keys
+        entries[i] = {(rng() % 5000) * 0x9e3779b97f4a7c15ull & mask,
+                      static_cast<pcl::index_t>(i)};
+      auto expected = entries;
+      std::stable_sort(expected.begin(),
+                       expected.end(),
+                       [](const auto& a, const auto& b) { return a.first < b.first; });
+      for (const unsigned threads : {1u, 2u, 3u}) {
+        SCOPED_TRACE(threads);
+        auto sorted = entries;
+        pcl::selective_seg::detail::radixSortByKey(sorted, bits, threads);
+        EXPECT_TRUE(sorted == expected);
+      }
     }
   }
 }
