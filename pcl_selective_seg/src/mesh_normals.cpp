@@ -568,29 +568,39 @@ medianEdgeLength(const Vector3fVector& positions,
   // correctly rounded, and Eigen's norm() is sqrt(squaredNorm()), so this is the
   // median of the lengths to the bit.
   std::vector<double> squares(3 * static_cast<std::size_t>(sampled));
-#ifdef _OPENMP
-#pragma omp parallel for num_threads(threads(num_threads)) schedule(static) \
-    if (static_cast<std::size_t>(sampled) >= detail::kMinParallelItems)
-#endif
-  for (std::ptrdiff_t j = 0; j < sampled; ++j) {
-    const Triangle& t = triangles[static_cast<std::size_t>(j) * stride];
-    for (int i = 0; i < 3; ++i)
-      squares[3 * j + i] =
-          (positions[t[i]].cast<double>() - positions[t[(i + 1) % 3]].cast<double>())
-              .squaredNorm();
-  }
-  // Selection of the element of rank n / 2: squares are non-negative, so their bit
-  // patterns order as they do. A histogram of the top 16 bits finds the bucket that
-  // holds the rank; only that bucket is partitioned.
-  const std::size_t rank = squares.size() / 2;
+  // Squares are non-negative, so their bit patterns order as they do: the range of the
+  // patterns, then a histogram over it, finds the bucket that holds the element of rank
+  // n / 2, and only that bucket is partitioned.
   const auto bits = [](double v) {
     std::uint64_t b;
     std::memcpy(&b, &v, sizeof b);
     return b;
   };
-  std::vector<std::uint32_t> histogram(1u << 16, 0);
+  std::uint64_t lowest = std::numeric_limits<std::uint64_t>::max(), highest = 0;
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(threads(num_threads)) schedule(static) \
+    if (static_cast<std::size_t>(sampled) >= detail::kMinParallelItems)          \
+    reduction(min : lowest) reduction(max : highest)
+#endif
+  for (std::ptrdiff_t j = 0; j < sampled; ++j) {
+    const Triangle& t = triangles[static_cast<std::size_t>(j) * stride];
+    for (int i = 0; i < 3; ++i) {
+      const double square =
+          (positions[t[i]].cast<double>() - positions[t[(i + 1) % 3]].cast<double>())
+              .squaredNorm();
+      squares[3 * j + i] = square;
+      lowest = std::min(lowest, bits(square));
+      highest = std::max(highest, bits(square));
+    }
+  }
+  // 4,096 buckets over [lowest, highest].
+  int shift = 0;
+  while (((highest - lowest) >> shift) >= 4096)
+    ++shift;
+  const std::size_t rank = squares.size() / 2;
+  std::vector<std::uint32_t> histogram(4096, 0);
   for (const double v : squares)
-    ++histogram[bits(v) >> 48];
+    ++histogram[(bits(v) - lowest) >> shift];
   std::size_t below = 0;
   std::uint64_t bucket = 0;
   while (below + histogram[bucket] <= rank)
@@ -598,7 +608,7 @@ medianEdgeLength(const Vector3fVector& positions,
   std::vector<double> candidates;
   candidates.reserve(histogram[bucket]);
   for (const double v : squares)
-    if ((bits(v) >> 48) == bucket)
+    if (((bits(v) - lowest) >> shift) == bucket)
       candidates.push_back(v);
   const auto middle = candidates.begin() + static_cast<std::ptrdiff_t>(rank - below);
   std::nth_element(candidates.begin(), middle, candidates.end());

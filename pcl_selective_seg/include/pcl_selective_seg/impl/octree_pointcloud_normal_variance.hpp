@@ -97,27 +97,51 @@ OctreePointCloudNormalVariance<PointT>::addPointsFromInputCloud()
 {
   if (!this->input_ || (!normals_ && !normal_vectors_) || !areas_)
     return false;
-  pcl::Indices valid;
-  const auto consider = [&](pcl::index_t i) {
-    if (isValidPoint(i))
-      valid.push_back(i);
+  // Which points are valid, and their box, in parallel (a flag per candidate, then one
+  // compaction in increasing order; min and max do not depend on the order).
+  const auto num_candidates = static_cast<std::ptrdiff_t>(
+      this->indices_ ? this->indices_->size() : this->input_->size());
+  const auto candidate = [&](std::ptrdiff_t k) {
+    return this->indices_ ? (*this->indices_)[k] : static_cast<pcl::index_t>(k);
   };
-  if (this->indices_)
-    std::for_each(this->indices_->begin(), this->indices_->end(), consider);
-  else
-    for (pcl::index_t i = 0; i < static_cast<pcl::index_t>(this->input_->size()); ++i)
-      consider(i);
-  if (valid.empty())
-    return false;
-
+  std::vector<std::uint8_t> is_valid(static_cast<std::size_t>(num_candidates));
   Eigen::Array3d lo = Eigen::Array3d::Constant(std::numeric_limits<double>::max());
   Eigen::Array3d hi = -lo;
-  for (const auto i : valid) {
-    const Eigen::Array3d p =
-        (*this->input_)[i].getVector3fMap().template cast<double>();
-    lo = lo.min(p);
-    hi = hi.max(p);
+#ifdef _OPENMP
+#pragma omp parallel num_threads(num_threads_) if (num_candidates >= 4096)
+#endif
+  {
+    Eigen::Array3d my_lo = lo, my_hi = hi;
+#ifdef _OPENMP
+#pragma omp for schedule(static)
+#endif
+    for (std::ptrdiff_t k = 0; k < num_candidates; ++k) {
+      const pcl::index_t i = candidate(k);
+      is_valid[k] = isValidPoint(i);
+      if (is_valid[k]) {
+        const Eigen::Array3d p =
+            (*this->input_)[i].getVector3fMap().template cast<double>();
+        my_lo = my_lo.min(p);
+        my_hi = my_hi.max(p);
+      }
+    }
+#ifdef _OPENMP
+#pragma omp critical(selseg_octree_box)
+#endif
+    {
+      lo = lo.min(my_lo);
+      hi = hi.max(my_hi);
+    }
   }
+  pcl::Indices valid;
+  valid.reserve(static_cast<std::size_t>(
+      std::count(is_valid.begin(), is_valid.end(), std::uint8_t{1})));
+  for (std::ptrdiff_t k = 0; k < num_candidates; ++k)
+    if (is_valid[k])
+      valid.push_back(candidate(k));
+  std::vector<std::uint8_t>().swap(is_valid);
+  if (valid.empty())
+    return false;
   // PCL's octree subtracts FLT_EPSILON (absolute) from each side of the box before
   // counting voxels: a narrower side (a scene smaller than 0.1 micrometre, or flat
   // along an axis with voxels under 12 micrometres) gave a negative count cast to an
@@ -354,8 +378,10 @@ OctreePointCloudNormalVariance<PointT>::computeAdaptiveLeaves(
   level[0].node = this->root_node_;
   std::vector<NodeStatistics> stats;
   std::vector<std::uint8_t> split;
+  std::vector<std::size_t> slot; // where a node kept as a leaf goes in leaves_
   while (!level.empty()) {
     stats.resize(level.size());
+    split.resize(level.size());
 #ifdef _OPENMP
 #pragma omp parallel for num_threads(num_threads_) schedule(dynamic, 8)
 #endif
@@ -369,27 +395,20 @@ OctreePointCloudNormalVariance<PointT>::computeAdaptiveLeaves(
       stats[i] = computeStatistics(range.first,
                                    range.second,
                                    can_split && finite_weights ? max_std_dev : kNever);
+      const bool varies =
+          stats[i].sigma_theta > max_std_dev || stats[i].sigma_phi > max_std_dev;
+      split[i] = varies && can_split;
     }
     next.clear();
     const std::size_t first_new_leaf = leaves_.size();
-    split.resize(level.size());
+    slot.resize(level.size());
     std::size_t num_new_leaves = 0;
     for (std::size_t i = 0; i < level.size(); ++i) {
-      const NodeStatistics& s = stats[i];
-      const bool varies = s.sigma_theta > max_std_dev || s.sigma_phi > max_std_dev;
-      split[i] = varies && level[i].node->getNodeType() == pcl::octree::BRANCH_NODE &&
-                 level[i].end - level[i].begin >= min_points;
-      num_new_leaves += split[i] ? 0 : 1;
-    }
-    // Grown by exactly this level's leaves: doubling would hold three times the leaves
-    // at the pipeline's peak of memory.
-    leaves_.reserve(first_new_leaf + num_new_leaves);
-    for (std::size_t i = 0; i < level.size(); ++i) {
-      const PendingNode& node = level[i];
       if (!split[i]) {
-        leaves_.push_back(makeLeaf(node, stats[i]));
+        slot[i] = first_new_leaf + num_new_leaves++;
         continue;
       }
+      const PendingNode& node = level[i];
       const auto* branch = static_cast<const BranchNode*>(node.node);
       for (unsigned char c = 0; c < 8; ++c) {
         if (const auto* child = branch->getChildPtr(c)) {
@@ -402,6 +421,17 @@ OctreePointCloudNormalVariance<PointT>::computeAdaptiveLeaves(
         }
       }
     }
+    // Grown by exactly this level's leaves: doubling would hold three times the leaves
+    // at the pipeline's peak of memory. The leaves (their areas are one pass over
+    // their points) are made in parallel, each into its own slot.
+    leaves_.reserve(first_new_leaf + num_new_leaves);
+    leaves_.resize(first_new_leaf + num_new_leaves);
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(num_threads_) schedule(dynamic, 64)
+#endif
+    for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(level.size()); ++i)
+      if (!split[i])
+        leaves_[slot[i]] = makeLeaf(level[i], stats[i]);
     // Depth-first order: the leaves' point ranges are disjoint and ordered so; each
     // level's leaves come in that order.
     std::inplace_merge(
