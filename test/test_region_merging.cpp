@@ -13,6 +13,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
+#include <random>
+#include <tuple>
 #include <vector>
 
 using pcl::selective_seg::classifyTriangles;
@@ -344,6 +347,138 @@ TEST(MergeSeedSegments, TriangleOverThreeSeeds)
   EXPECT_EQ(m.leaf_segment, (Segments{0, 0, 0, 1}));
   ASSERT_EQ(m.segment_normals.size(), 2u);
   EXPECT_NEAR(angleDeg(m.segment_normals[0], tilted(0.0)), 0.0, 1e-3);
+}
+
+/** A grid of n x n vertices, two triangles per cell, with b x b vertex blocks as leaves
+ * (numbered row by row, or in a shuffled order), leaf normals from a smooth field with
+ * noise (segments of many sizes, some across the whole grid), triangle normals from
+ * their leaves with noise, a few degenerate (NaN) and edge-on triangles, and some
+ * vertices in no leaf. */
+struct NoisyGrid {
+  Vector3fVector leaf_normals;
+  std::vector<double> leaf_areas;
+  std::vector<pcl::index_t> vertex_leaf;
+  std::vector<Triangle> triangles;
+  Vector3fVector triangle_normals;
+  std::vector<std::uint8_t> edge_on;
+
+  NoisyGrid(int n, int b, bool shuffle_leaves, unsigned seed)
+  {
+    std::mt19937 rng(seed);
+    std::normal_distribution<double> noise(0.0, 1.0);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    const int blocks = (n + b - 1) / b;
+    std::vector<pcl::index_t> block_leaf(static_cast<std::size_t>(blocks * blocks));
+    std::iota(block_leaf.begin(), block_leaf.end(), 0);
+    if (shuffle_leaves)
+      std::shuffle(block_leaf.begin(), block_leaf.end(), rng);
+    leaf_normals.resize(block_leaf.size());
+    for (int by = 0; by < blocks; ++by)
+      for (int bx = 0; bx < blocks; ++bx) {
+        // Four tilted tiles, a ridge and noise: flat regions, sharp and soft edges.
+        const double x = static_cast<double>(bx) / blocks,
+                     y = static_cast<double>(by) / blocks;
+        const double tilt_x = (x < 0.5 ? -20.0 : 20.0) + 15.0 * std::sin(7.0 * y) +
+                              14.0 * noise(rng),
+                     tilt_y = (y < 0.5 ? -15.0 : 15.0) + 14.0 * noise(rng);
+        const Eigen::Vector3d normal =
+            Eigen::Vector3d(std::sin(tilt_x * kDeg), std::sin(tilt_y * kDeg), -1.0)
+                .normalized();
+        leaf_normals[block_leaf[by * blocks + bx]] = normal.cast<float>();
+      }
+    for (std::size_t l = 0; l < leaf_normals.size(); ++l)
+      leaf_areas.push_back(0.5 + unit(rng));
+    for (int y = 0; y < n; ++y)
+      for (int x = 0; x < n; ++x)
+        vertex_leaf.push_back(unit(rng) < 0.02 ? -1
+                                               : block_leaf[(y / b) * blocks + x / b]);
+    const auto id = [n](int x, int y) { return static_cast<pcl::index_t>(y * n + x); };
+    for (int y = 0; y + 1 < n; ++y)
+      for (int x = 0; x + 1 < n; ++x) {
+        triangles.push_back({id(x, y), id(x + 1, y), id(x, y + 1)});
+        triangles.push_back({id(x + 1, y), id(x + 1, y + 1), id(x, y + 1)});
+      }
+    for (const auto& t : triangles) {
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      for (const auto v : t)
+        if (vertex_leaf[v] >= 0)
+          sum += leaf_normals[vertex_leaf[v]].cast<double>();
+      sum += 0.3 * Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
+      Eigen::Vector3f normal = sum.normalized().cast<float>();
+      if (unit(rng) < 0.01)
+        normal.setConstant(std::numeric_limits<float>::quiet_NaN());
+      triangle_normals.push_back(normal);
+      edge_on.push_back(unit(rng) < 0.02 ? 1 : 0);
+    }
+  }
+
+  MergeInput input(int threads) const
+  {
+    MergeInput in;
+    in.leaf_normals = &leaf_normals;
+    in.leaf_areas = &leaf_areas;
+    in.vertex_leaf = &vertex_leaf;
+    in.triangles = &triangles;
+    in.triangle_normals = &triangle_normals;
+    in.triangle_edge_on = &edge_on;
+    in.max_merge_angle = kThreshold;
+    in.max_edge_triangle_angle = kThreshold;
+    in.num_threads = threads;
+    return in;
+  }
+};
+
+// The growth of many seeds runs on several threads, each growing the seeds of its part
+// of the leaves ahead of their turn; the result must be the one-thread run's, bit for
+// bit: the same segment of every leaf, in the same numbering, and the same normals.
+// Shuffled leaf numbers make every part a scattered set, so that many grown segments
+// meet others and must grow again; over 4,096 seeds run in several windows.
+TEST(MergeSeedSegments, SameResultForAnyThreadCount)
+{
+  const std::vector<std::tuple<int, int, bool>> grids{
+      {70, 2, false}, {70, 2, true}, {150, 2, false}, {150, 2, true}, {150, 3, true}};
+  for (const auto& [n, b, shuffle] : grids) {
+    SCOPED_TRACE(::testing::Message() << n << " " << b << " " << shuffle);
+    const NoisyGrid grid(n, b, shuffle, static_cast<unsigned>(n + b));
+    ASSERT_GE(grid.leaf_normals.size(), 1024u); // the size that runs on threads
+    Merged one;
+    mergeSeedSegments(grid.input(1), one.leaf_segment, one.segment_normals);
+    // Segments of one leaf and of many: the growth has work to do.
+    ASSERT_GT(one.segment_normals.size(), 20u);
+    ASSERT_LT(one.segment_normals.size(), grid.leaf_normals.size() / 2);
+    for (const int threads : {2, 3, 4}) {
+      SCOPED_TRACE(threads);
+      Merged many;
+      mergeSeedSegments(grid.input(threads), many.leaf_segment, many.segment_normals);
+      EXPECT_EQ(many.leaf_segment, one.leaf_segment);
+      ASSERT_EQ(many.segment_normals.size(), one.segment_normals.size());
+      for (std::size_t s = 0; s < one.segment_normals.size(); ++s)
+        ASSERT_EQ(many.segment_normals[s], one.segment_normals[s]) << s;
+    }
+  }
+}
+
+// The octree's leaves can be given in place of the normal and area arrays.
+TEST(MergeSeedSegments, LeavesInPlaceOfArrays)
+{
+  const NoisyGrid grid(70, 2, true, 5);
+  std::vector<pcl::selective_seg::AdaptiveLeaf> leaves(grid.leaf_normals.size());
+  for (std::size_t l = 0; l < leaves.size(); ++l) {
+    leaves[l].normal = grid.leaf_normals[l];
+    leaves[l].area = grid.leaf_areas[l];
+  }
+  for (const int threads : {1, 2}) {
+    MergeInput arrays = grid.input(threads);
+    MergeInput in_place = arrays;
+    in_place.leaf_normals = nullptr;
+    in_place.leaf_areas = nullptr;
+    in_place.leaves = &leaves;
+    Merged a, b;
+    mergeSeedSegments(arrays, a.leaf_segment, a.segment_normals);
+    mergeSeedSegments(in_place, b.leaf_segment, b.segment_normals);
+    EXPECT_EQ(a.leaf_segment, b.leaf_segment);
+    EXPECT_EQ(a.segment_normals, b.segment_normals);
+  }
 }
 
 TEST(ClassifyTriangles, Classes)

@@ -9,6 +9,10 @@
 
 #include "incidence_build.h"
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -69,6 +73,25 @@ vertexTriangles(const std::vector<Triangle>& triangles,
 
 namespace {
 
+/** The leaves' count, normals and areas, from whichever form the input gives. */
+std::size_t
+numLeaves(const MergeInput& in)
+{
+  return in.leaves ? in.leaves->size() : in.leaf_normals->size();
+}
+
+const Eigen::Vector3f&
+leafNormal(const MergeInput& in, pcl::index_t l)
+{
+  return in.leaves ? (*in.leaves)[l].normal : (*in.leaf_normals)[l];
+}
+
+double
+leafArea(const MergeInput& in, pcl::index_t l)
+{
+  return in.leaves ? (*in.leaves)[l].area : (*in.leaf_areas)[l];
+}
+
 /** A segment while it grows: eq. 7 as a running sum. */
 struct GrowingSegment {
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
@@ -128,7 +151,7 @@ struct LeafTriangles {
   {
     detail::buildBuckets<LeafTriangle>(
         in.triangles->size(),
-        in.leaf_normals->size(),
+        numLeaves(in),
         [&](std::size_t t, auto f) {
           const auto leaves = leavesOf(static_cast<pcl::index_t>(t));
           if (spansLeaves(leaves)) {
@@ -171,36 +194,63 @@ struct LeafTriangles {
   }
 };
 
-class SeedMerger {
+/** Which segment holds each leaf, as the sequential growth sees it. */
+struct SharedState {
+  std::vector<pcl::index_t>& leaf_segment;
+  pcl::index_t k; ///< the growing segment
+
+  bool claimed(pcl::index_t l) const { return leaf_segment[l] >= 0; }
+  bool own(pcl::index_t l) const { return leaf_segment[l] == k; }
+  /** Held by another segment, and to be noted (never here). */
+  bool noteHeld(pcl::index_t) const { return false; }
+  void claim(pcl::index_t l) { leaf_segment[l] = k; }
+};
+
+/** A thread's view while it grows seeds ahead of their turn: the shared state as the
+ * last window left it (read only), plus the segments this thread grew in this window
+ * (an overlay of window-local ids + 1; 0: none). */
+struct OverlayState {
+  const std::vector<pcl::index_t>& leaf_segment;
+  std::vector<std::uint16_t>& overlay;
+  std::vector<std::uint8_t>& noted; ///< leaves already noted for this segment
+  std::uint16_t k;                  ///< the growing segment's window-local id + 1
+
+  bool claimed(pcl::index_t l) const { return leaf_segment[l] >= 0 || overlay[l] != 0; }
+  bool own(pcl::index_t l) const { return overlay[l] == k; }
+  /** Whether l is held by another segment of this window and not yet noted (a leaf
+   * held in the shared state stays held: nothing to check). */
+  bool noteHeld(pcl::index_t l)
+  {
+    if (leaf_segment[l] >= 0 || overlay[l] == k || noted[l])
+      return false;
+    noted[l] = 1;
+    return true;
+  }
+  void claim(pcl::index_t l) { overlay[l] = k; }
+};
+
+/** The growth of one segment from its seed (eq. 7-10) over a state that says which
+ * leaves are claimed and which are this segment's. With a record, it also notes, once
+ * each, the leaves it met held by another segment of the same window: with the leaves
+ * it claimed (queue()), all that its outcome depends on besides the input (see
+ * SeedMerger::run()). */
+class SegmentGrowth {
 public:
-  explicit SeedMerger(const MergeInput& in)
+  SegmentGrowth(const MergeInput& in, const LeafTriangles& adjacency)
       : in_(in)
-      , adjacency_(in)
+      , adjacency_(adjacency)
       , cos_merge_(std::cos(in.max_merge_angle))
       , cos_edge_(std::cos(in.max_edge_triangle_angle))
   {
   }
 
-  void run(std::vector<pcl::index_t>& leaf_segment, Vector3fVector& segment_normals)
-  {
-    leaf_segment.assign(in_.leaf_normals->size(), -1);
-    segment_normals.clear();
-    for (const auto seed : seedOrder(*in_.vertex_leaf, in_.leaf_normals->size())) {
-      if (leaf_segment[seed] >= 0)
-        continue;
-      const auto k = static_cast<pcl::index_t>(segment_normals.size());
-      segment_normals.push_back(grow(seed, k, leaf_segment).cast<float>());
-    }
-  }
-
-private:
-  /** Breadth first from the seed; queue_ is reused across segments. */
+  template <typename State>
   Eigen::Vector3d
-  grow(pcl::index_t seed, pcl::index_t k, std::vector<pcl::index_t>& leaf_segment)
+  grow(pcl::index_t seed, State& state, std::vector<pcl::index_t>* held = nullptr)
   {
     GrowingSegment segment;
-    segment.add((*in_.leaf_normals)[seed], (*in_.leaf_areas)[seed]);
-    leaf_segment[seed] = k;
+    segment.add(leafNormal(in_, seed), leafArea(in_, seed));
+    state.claim(seed);
     queue_.assign(1, seed);
     for (std::size_t head = 0; head < queue_.size(); ++head) {
       const auto leaf = queue_[head];
@@ -212,32 +262,42 @@ private:
           const pcl::index_t ahead = adjacency_.entries[i + 8].triangle;
           __builtin_prefetch(&(*in_.triangle_normals)[ahead]);
         }
-        visitTriangle(adjacency_.entries[i], k, segment, leaf_segment);
+        visitTriangle(adjacency_.entries[i], segment, state, held);
       }
     }
     return segment.normal;
   }
 
+  /** The leaves the last grow() claimed, in the order it claimed them. */
+  const std::vector<pcl::index_t>& queue() const { return queue_; }
+
+private:
+  template <typename State>
   void visitTriangle(const LeafTriangle& entry,
-                     pcl::index_t k,
                      GrowingSegment& segment,
-                     std::vector<pcl::index_t>& leaf_segment)
+                     State& state,
+                     std::vector<pcl::index_t>* held)
   {
     const auto& leaves = entry.leaves;
     const pcl::index_t t = entry.triangle;
     const bool edge = std::any_of(leaves.begin(), leaves.end(), [&](pcl::index_t l) {
-      return l >= 0 && leaf_segment[l] != k;
+      return l >= 0 && !state.own(l);
     });
     if (!edge || t < 0 || !isValidFor(t, segment.normal))
       return; // interior, or an invalid edge triangle (eq. 8; t < 0: edge-on)
     for (const auto other : leaves) {
-      if (other < 0 || leaf_segment[other] >= 0)
+      if (other < 0)
         continue;
-      const Eigen::Vector3f& n_other = (*in_.leaf_normals)[other];
+      if (state.claimed(other)) {
+        if (held && state.noteHeld(other))
+          held->push_back(other);
+        continue;
+      }
+      const Eigen::Vector3f& n_other = leafNormal(in_, other);
       if (n_other.cast<double>().dot(segment.normal) < cos_merge_)
-        continue;              // eq. 9
-      leaf_segment[other] = k; // eq. 10
-      segment.add(n_other, (*in_.leaf_areas)[other]);
+        continue;         // eq. 9
+      state.claim(other); // eq. 10
+      segment.add(n_other, leafArea(in_, other));
       queue_.push_back(other);
     }
   }
@@ -252,10 +312,177 @@ private:
   }
 
   const MergeInput& in_;
-  LeafTriangles adjacency_;
+  const LeafTriangles& adjacency_;
   std::vector<pcl::index_t> queue_;
   double cos_merge_;
   double cos_edge_;
+};
+
+/** One thread's segments grown ahead of their turn in a window of the seed order, from
+ * the seeds of its part of the leaves. */
+struct Speculation {
+  struct Segment {
+    pcl::index_t seed;
+    std::uint32_t claimed_end; ///< its leaves: claimed[previous end, claimed_end)
+    std::uint32_t held_end;    ///< held[previous end, held_end)
+    Eigen::Vector3d normal;
+  };
+  std::vector<Segment> segments;
+  std::vector<pcl::index_t> claimed;
+  std::vector<pcl::index_t> held;
+  std::vector<std::uint16_t> overlay; ///< #L, OverlayState::overlay
+  std::vector<std::uint8_t> noted;    ///< #L, OverlayState::noted
+};
+
+class SeedMerger {
+public:
+  explicit SeedMerger(const MergeInput& in) : in_(in), adjacency_(in) {}
+
+  /** The seeds in order, each unassigned one growing a segment.
+   *
+   * On several threads (enough leaves), the order is taken in windows of kWindow
+   * seeds. In a window, each thread first grows the window's seeds of its part of the
+   * leaves (a range of octree order, a region of space), over the state the previous
+   * windows left plus its own segments of this window, as if the other parts' seeds of
+   * the window did not exist; it notes the leaves each segment claimed and those it
+   * found held by its own earlier segments of the window. Then, in seed order, a grown
+   * segment is taken as is when its growth met the state the sequential run meets:
+   * each leaf it claimed is still free, and each leaf it found held is held. The
+   * growth reads nothing else that can differ (which segment holds a leaf never
+   * matters, only whether it is this one, and a free leaf that a test turned down is
+   * left alone whether free or held), so it makes the same decisions in the same order
+   * and ends with the same normal. Otherwise the segment grows again there, over the
+   * true state. The result is the sequential run's, bit for bit, for any thread
+   * count; the windows bound the memory the threads' notes take. */
+  void run(std::vector<pcl::index_t>& leaf_segment, Vector3fVector& segment_normals)
+  {
+    const std::size_t num_leaves = numLeaves(in_);
+    leaf_segment.assign(num_leaves, -1);
+    segment_normals.clear();
+    const std::vector<pcl::index_t> order = seedOrder(*in_.vertex_leaf, num_leaves);
+    const std::size_t parts = static_cast<std::size_t>(
+        in_.num_threads > 0 ? in_.num_threads : static_cast<int>(defaultThreads()));
+    SegmentGrowth growth(in_, adjacency_);
+    const auto growHere = [&](pcl::index_t seed) {
+      const auto k = static_cast<pcl::index_t>(segment_normals.size());
+      SharedState state{leaf_segment, k};
+      segment_normals.push_back(growth.grow(seed, state).cast<float>());
+    };
+    if (parts < 2 || num_leaves < kMinParallelLeaves) {
+      for (const auto seed : order)
+        if (leaf_segment[seed] < 0)
+          growHere(seed);
+      return;
+    }
+    // Part p is the leaves [bounds[p], bounds[p + 1]).
+    std::vector<std::size_t> bounds(parts + 1);
+    for (std::size_t p = 0; p <= parts; ++p)
+      bounds[p] = num_leaves * p / parts;
+    std::vector<Speculation> ahead(parts);
+    for (auto& a : ahead) {
+      a.overlay.assign(num_leaves, 0);
+      a.noted.assign(num_leaves, 0);
+    }
+    for (std::size_t w = 0; w < order.size(); w += kWindow) {
+      const std::size_t w_end = std::min(order.size(), w + kWindow);
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(static_cast<int>(parts)) schedule(static, 1)
+#endif
+      for (std::ptrdiff_t p = 0; p < static_cast<std::ptrdiff_t>(parts); ++p)
+        speculate(order, w, w_end, bounds[p], bounds[p + 1], leaf_segment, ahead[p]);
+      std::vector<std::size_t> next(parts, 0); // each part's next grown segment
+      for (std::size_t i = w; i < w_end; ++i) {
+        const pcl::index_t seed = order[i];
+        const auto above = std::upper_bound(
+            bounds.begin(), bounds.end(), static_cast<std::size_t>(seed));
+        const auto part = static_cast<std::size_t>(above - bounds.begin() - 1);
+        const Speculation& mine = ahead[part];
+        const Speculation::Segment* grown = nullptr;
+        std::size_t claimed_begin = 0, held_begin = 0;
+        if (next[part] < mine.segments.size() &&
+            mine.segments[next[part]].seed == seed) {
+          if (next[part] > 0) {
+            claimed_begin = mine.segments[next[part] - 1].claimed_end;
+            held_begin = mine.segments[next[part] - 1].held_end;
+          }
+          grown = &mine.segments[next[part]++];
+        }
+        if (leaf_segment[seed] >= 0)
+          continue;
+        if (grown &&
+            stillValid(*grown, claimed_begin, held_begin, mine, leaf_segment)) {
+          const auto k = static_cast<pcl::index_t>(segment_normals.size());
+          for (std::size_t c = claimed_begin; c < grown->claimed_end; ++c)
+            leaf_segment[mine.claimed[c]] = k;
+          segment_normals.push_back(grown->normal.cast<float>());
+          continue;
+        }
+        growHere(seed);
+      }
+      for (auto& a : ahead)
+        for (const auto l : a.claimed)
+          a.overlay[l] = 0;
+    }
+  }
+
+private:
+  /** Below this many leaves the growth runs on one thread. */
+  static constexpr std::size_t kMinParallelLeaves = 1024;
+  /** Seeds per window (window-local ids fit the overlay's 16 bits). */
+  static constexpr std::size_t kWindow = 4096;
+
+  /** Grow the seeds order[w, w_end) that lie in [first, last), in order. */
+  void speculate(const std::vector<pcl::index_t>& order,
+                 std::size_t w,
+                 std::size_t w_end,
+                 std::size_t first,
+                 std::size_t last,
+                 const std::vector<pcl::index_t>& leaf_segment,
+                 Speculation& out) const
+  {
+    out.segments.clear();
+    out.claimed.clear();
+    out.held.clear();
+    SegmentGrowth growth(in_, adjacency_);
+    for (std::size_t i = w; i < w_end; ++i) {
+      const pcl::index_t seed = order[i];
+      if (static_cast<std::size_t>(seed) < first ||
+          static_cast<std::size_t>(seed) >= last || leaf_segment[seed] >= 0 ||
+          out.overlay[seed] != 0)
+        continue;
+      const auto k = static_cast<std::uint16_t>(out.segments.size() + 1);
+      OverlayState state{leaf_segment, out.overlay, out.noted, k};
+      const std::size_t held_begin = out.held.size();
+      Speculation::Segment s;
+      s.seed = seed;
+      s.normal = growth.grow(seed, state, &out.held);
+      for (std::size_t h = held_begin; h < out.held.size(); ++h)
+        out.noted[out.held[h]] = 0;
+      const auto& queue = growth.queue();
+      out.claimed.insert(out.claimed.end(), queue.begin(), queue.end());
+      s.claimed_end = static_cast<std::uint32_t>(out.claimed.size());
+      s.held_end = static_cast<std::uint32_t>(out.held.size());
+      out.segments.push_back(s);
+    }
+  }
+
+  static bool stillValid(const Speculation::Segment& s,
+                         std::size_t claimed_begin,
+                         std::size_t held_begin,
+                         const Speculation& from,
+                         const std::vector<pcl::index_t>& leaf_segment)
+  {
+    for (std::size_t i = claimed_begin; i < s.claimed_end; ++i)
+      if (leaf_segment[from.claimed[i]] >= 0)
+        return false;
+    for (std::size_t i = held_begin; i < s.held_end; ++i)
+      if (leaf_segment[from.held[i]] < 0)
+        return false;
+    return true;
+  }
+
+  const MergeInput& in_;
+  LeafTriangles adjacency_;
 };
 
 } // namespace

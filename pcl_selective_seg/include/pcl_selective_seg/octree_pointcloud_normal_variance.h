@@ -6,6 +6,7 @@
 
 #pragma once
 
+#include <pcl_selective_seg/adaptive_leaf.h>
 #include <pcl_selective_seg/octree_normal_variance_container.h>
 
 #include <Eigen/Geometry>
@@ -20,18 +21,6 @@
 
 namespace pcl {
 namespace selective_seg {
-
-/** \brief A node of the multi-resolution octree taken as a leaf (a seed segment). */
-struct AdaptiveLeaf {
-  pcl::octree::OctreeKey key; ///< key of the node at its own depth
-  std::uint32_t depth = 0;    ///< 0 = root
-  std::size_t begin = 0;      ///< its points: getOrderedIndices()[begin, end)
-  std::size_t end = 0;
-  Eigen::Vector3f normal = Eigen::Vector3f::Zero(); ///< N_v (eq. 4), input orientation
-  double area = 0.0;                                ///< A_v = sum of A_p (eq. 6)
-  float sigma_theta = 0.0f;                         ///< eq. 5 [rad]
-  float sigma_phi = 0.0f;                           ///< eq. 5 [rad]
-};
 
 /** \brief Multi-resolution octree whose voxels split while their normals vary (paper,
  * Sec. III.C, eq. 3-5).

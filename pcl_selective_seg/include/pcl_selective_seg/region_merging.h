@@ -6,6 +6,7 @@
 
 #pragma once
 
+#include <pcl_selective_seg/adaptive_leaf.h>
 #include <pcl_selective_seg/mesh_normals.h>
 #include <pcl_selective_seg/segmentation_result.h>
 
@@ -21,6 +22,9 @@ namespace selective_seg {
 struct MergeInput {
   const Vector3fVector* leaf_normals = nullptr; ///< #L unit voxel normals N_v (eq. 4)
   const std::vector<double>* leaf_areas = nullptr; ///< #L voxel areas A_v (eq. 6) [m^2]
+  /** Instead of leaf_normals and leaf_areas (then unused): the octree's leaves, whose
+   * normal and area fields are read in place. */
+  const std::vector<AdaptiveLeaf>* leaves = nullptr;
   const std::vector<pcl::index_t>* vertex_leaf =
       nullptr; ///< #V leaf of each vertex, -1: none
   const std::vector<Triangle>* triangles = nullptr; ///< #T triangles over vertex ids
@@ -31,8 +35,8 @@ struct MergeInput {
   const std::vector<std::uint8_t>* triangle_edge_on = nullptr;
   double max_merge_angle = 0.0;         ///< eq. 9 threshold [rad]
   double max_edge_triangle_angle = 0.0; ///< eq. 8 threshold [rad]
-  /** Threads for building the incidence lists (0: all cores); the growth itself is
-   * sequential. The result does not depend on it. */
+  /** Threads for building the incidence lists and for growing seeds ahead of their
+   * turn (0: all cores). The result does not depend on it. */
   int num_threads = 1;
 };
 
@@ -47,6 +51,12 @@ struct MergeInput {
  * N_Sk is the normalized sum of N_v / A_v over its seeds (eq. 7), updated at every
  * join. Each seed joins once and each triangle is examined at most once per leaf of
  * its vertices: linear in the mesh size.
+ *
+ * With several threads and at least 1,024 leaves, the threads grow seeds ahead of
+ * their turn, each over its own part of the leaves, and a segment so grown is kept
+ * only when the state it met is the one the sequential growth meets (otherwise it
+ * grows again in turn): the result is the one-thread result, bit for bit
+ * (docs/performance.md, "Round 6").
  *
  * \param[in] input the seeds and the mesh
  * \param[out] leaf_segment #L segment id of each seed, 0..#S-1 in creation order

@@ -462,16 +462,8 @@ void
 SelectiveSegmentation<PointT>::mergeAndLabel()
 {
   const SphericalTriangulation& tri = delaunay_.getTriangulation();
-  const auto& leaves = octree_->getAdaptiveLeaves();
-  Vector3fVector leaf_normals(leaves.size());
-  std::vector<double> leaf_areas(leaves.size());
-  for (std::size_t l = 0; l < leaves.size(); ++l) {
-    leaf_normals[l] = leaves[l].normal;
-    leaf_areas[l] = leaves[l].area;
-  }
   MergeInput in;
-  in.leaf_normals = &leaf_normals;
-  in.leaf_areas = &leaf_areas;
+  in.leaves = &octree_->getAdaptiveLeaves();
   in.vertex_leaf = &vertex_leaf_;
   in.triangles = &tri.triangles;
   in.triangle_normals = &edgeTestNormals();
