@@ -93,6 +93,47 @@ expectSameTriangulation(const SphericalTriangulation& a,
 
 } // namespace
 
+// The fast quantized angle must be std::lround(std::atan2(y, x) / step) exactly: on
+// random directions of every steepness and scale, at several steps, and on directions
+// whose quotient lies within a hair of a half-integer (where it must fall back).
+TEST(QuantizedAngle, SameAsAtan2RoundedEverywhere)
+{
+  using pcl::selective_seg::detail::quantizedAngle;
+  const auto reference = [](double y, double x, double step) {
+    return std::lround(std::atan2(y, x) / step);
+  };
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0), decades(-6.0, 6.0);
+  long mismatches = 0, near_half = 0;
+  for (const double step : {1e-7, 3.3e-9, 1e-12, 1e-4, 0.01, 0.7}) {
+    SCOPED_TRACE(step);
+    for (int i = 0; i < 400000; ++i) {
+      const double x = std::pow(10.0, decades(rng)) * (0.5 + std::fabs(unit(rng)));
+      const double y = unit(rng) * x * std::pow(10.0, decades(rng));
+      mismatches += quantizedAngle(y, x, step) != reference(y, x, step);
+    }
+    // A direction at (k + 1/2) step, and a few ulps around it.
+    for (int i = 0; i < 20000; ++i) {
+      const double x = 0.5 + std::fabs(unit(rng));
+      const double half = (std::floor(unit(rng) * 1.5 / step) + 0.5) * step;
+      double y = x * std::tan(half);
+      for (int ulp = 0; ulp < 4; ++ulp, y = std::nextafter(y, 2.0 * y)) {
+        const double t = std::atan2(y, x) / step;
+        near_half += std::fabs(std::fabs(t - std::trunc(t)) - 0.5) < 1e-6;
+        mismatches += quantizedAngle(y, x, step) != reference(y, x, step);
+      }
+    }
+  }
+  EXPECT_EQ(mismatches, 0);
+  EXPECT_GT(near_half, 100000); // the fallback was needed
+  // Special values: zeros of both signs, the diagonal, extreme slopes, subnormals.
+  const double tiny = std::numeric_limits<double>::denorm_min();
+  for (const double step : {1e-7, 1e-3})
+    for (const double x : {1.0, 1e-300, 1e300, 3.0})
+      for (const double y : {0.0, -0.0, x, -x, tiny, -tiny, 1e-200 * x, 1e200, -1e200})
+        EXPECT_EQ(quantizedAngle(y, x, step), reference(y, x, step)) << y << " " << x;
+}
+
 TEST(SphericalDelaunay, AnglesOfEquation1)
 {
   // With a step of 1e-4 rad: pi/4 -> 7853.98 -> 7854; atan2(1, 2) = 0.4636476 -> 4636;

@@ -8,6 +8,10 @@
 #include <pcl_selective_seg/region_merging.h>
 #include <pcl_selective_seg/spherical_delaunay.h>
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -593,23 +597,55 @@ medianEdgeLength(const Vector3fVector& positions,
       highest = std::max(highest, bits(square));
     }
   }
-  // 4,096 buckets over [lowest, highest].
+  // 4,096 buckets over [lowest, highest]; a histogram per thread, then their sum.
   int shift = 0;
   while (((highest - lowest) >> shift) >= 4096)
     ++shift;
+  const auto bucketOf = [&](double v) { return (bits(v) - lowest) >> shift; };
   const std::size_t rank = squares.size() / 2;
-  std::vector<std::uint32_t> histogram(4096, 0);
-  for (const double v : squares)
-    ++histogram[(bits(v) - lowest) >> shift];
+  const auto num_squares = static_cast<std::ptrdiff_t>(squares.size());
+  const bool parallel = static_cast<std::size_t>(sampled) >= detail::kMinParallelItems;
+  const int num_parts = parallel ? threads(num_threads) : 1;
+  std::vector<std::uint32_t> histograms(4096 * static_cast<std::size_t>(num_parts), 0);
+#ifdef _OPENMP
+#pragma omp parallel num_threads(num_parts) if (parallel)
+#endif
+  {
+#ifdef _OPENMP
+    std::uint32_t* histogram = histograms.data() + 4096 * omp_get_thread_num();
+#pragma omp for schedule(static)
+#else
+    std::uint32_t* histogram = histograms.data();
+#endif
+    for (std::ptrdiff_t k = 0; k < num_squares; ++k)
+      ++histogram[bucketOf(squares[k])];
+  }
+  for (int p = 1; p < num_parts; ++p)
+    for (std::size_t b = 0; b < 4096; ++b)
+      histograms[b] += histograms[4096 * static_cast<std::size_t>(p) + b];
   std::size_t below = 0;
   std::uint64_t bucket = 0;
-  while (below + histogram[bucket] <= rank)
-    below += histogram[bucket++];
+  while (below + histograms[bucket] <= rank)
+    below += histograms[bucket++];
+  // The bucket's values, in any order (the value of a rank does not depend on it).
   std::vector<double> candidates;
-  candidates.reserve(histogram[bucket]);
-  for (const double v : squares)
-    if (((bits(v) - lowest) >> shift) == bucket)
-      candidates.push_back(v);
+  candidates.reserve(histograms[bucket]);
+#ifdef _OPENMP
+#pragma omp parallel num_threads(num_parts) if (parallel)
+#endif
+  {
+    std::vector<double> mine;
+#ifdef _OPENMP
+#pragma omp for schedule(static) nowait
+#endif
+    for (std::ptrdiff_t k = 0; k < num_squares; ++k)
+      if (bucketOf(squares[k]) == bucket)
+        mine.push_back(squares[k]);
+#ifdef _OPENMP
+#pragma omp critical(selseg_median_candidates)
+#endif
+    candidates.insert(candidates.end(), mine.begin(), mine.end());
+  }
   const auto middle = candidates.begin() + static_cast<std::ptrdiff_t>(rank - below);
   std::nth_element(candidates.begin(), middle, candidates.end());
   return std::sqrt(*middle);

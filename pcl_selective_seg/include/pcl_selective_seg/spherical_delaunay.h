@@ -26,6 +26,18 @@ defaultThreads()
   return std::max(1u, std::thread::hardware_concurrency());
 }
 
+namespace detail {
+
+/** \brief std::lround(std::atan2(y, x) / step), the quantized angle of eq. 1, bit for
+ * bit, for x > 0, finite y and step > 0, about twice as fast: atan(|y| / x) from a
+ * table of atan(i / 8) and a short series (within 1e-15 rad), and the exact expression
+ * only when the quotient lies so near a half-integer (within 1e-13 rad / step) that
+ * the two could round apart. */
+PCL_EXPORTS long
+quantizedAngle(double y, double x, double step);
+
+} // namespace detail
+
 /** \brief Why a point has no mesh vertex (values of
  * SphericalTriangulation::point_vertex). */
 enum PointStatus : pcl::index_t {

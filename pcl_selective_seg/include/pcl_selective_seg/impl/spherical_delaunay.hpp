@@ -147,9 +147,9 @@ SphericalDelaunay<PointT>::projectPoint(const Eigen::Affine3d& pose,
   // eq. 1; both angles lie in (-pi/2, pi/2) because z > 0.
   const QuantizedPoint q{
       static_cast<std::int32_t>(
-          std::lround(std::atan2(s.x(), s.z()) / angle_quantization_)),
+          detail::quantizedAngle(s.x(), s.z(), angle_quantization_)),
       static_cast<std::int32_t>(
-          std::lround(std::atan2(s.y(), s.z()) / angle_quantization_))};
+          detail::quantizedAngle(s.y(), s.z(), angle_quantization_))};
   return {detail::angleKey(q), index};
 }
 
