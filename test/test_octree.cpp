@@ -594,13 +594,60 @@ TEST(OctreePointCloudNormalVariance, SameTreeAsPclInsertion)
     for (; mine != ours->leaf_depth_end() && theirs != pcl_tree.leaf_depth_end();
          ++mine, ++theirs, ++leaves) {
       ASSERT_EQ(mine.getCurrentOctreeKey(), theirs.getCurrentOctreeKey());
-      ASSERT_EQ(mine.getLeafContainer().getPointIndicesVector(),
-                theirs.getLeafContainer().getPointIndicesVector());
+      pcl::Indices mine_indices, their_indices;
+      mine.getLeafContainer().getPointIndices(mine_indices);
+      theirs.getLeafContainer().getPointIndices(their_indices);
+      ASSERT_EQ(mine_indices, their_indices);
+      ASSERT_EQ(mine.getLeafContainer().getSize(), theirs.getLeafContainer().getSize());
     }
     EXPECT_TRUE(mine == ours->leaf_depth_end());
     EXPECT_TRUE(theirs == pcl_tree.leaf_depth_end());
     EXPECT_EQ(leaves, pcl_tree.getLeafCount());
   }
+}
+
+// The bulk insertion's leaf containers view one array of the tree; a copy of the tree
+// holds its own indices (it outlives the original here), and a container that PCL's
+// point-by-point insertion adds to keeps its indices and the new one.
+TEST(OctreePointCloudNormalVariance, LeafContainersViewAndCopy)
+{
+  const Scene scene = ridge();
+  using Octree = pcl::selective_seg::OctreePointCloudNormalVariance<pcl::PointXYZ>;
+  std::vector<pcl::Indices> original;
+  std::unique_ptr<Octree> copy;
+  {
+    const auto built = buildOctree(scene, 0.05, kPaperThreshold);
+    for (auto it = built->leaf_depth_begin(); it != built->leaf_depth_end(); ++it) {
+      original.emplace_back();
+      it.getLeafContainer().getPointIndices(original.back());
+      ASSERT_EQ(original.back().size(), it.getLeafContainer().getSize());
+    }
+    copy = std::make_unique<Octree>(*built);
+  } // the original tree and its index array are gone
+  std::size_t l = 0;
+  for (auto it = copy->leaf_depth_begin(); it != copy->leaf_depth_end(); ++it, ++l) {
+    pcl::Indices indices;
+    it.getLeafContainer().getPointIndices(indices);
+    ASSERT_LT(l, original.size());
+    EXPECT_EQ(indices, original[l]);
+  }
+  EXPECT_EQ(l, original.size());
+
+  const auto tree = buildOctree(scene, 0.05, kPaperThreshold);
+  auto& container = tree->leaf_depth_begin().getLeafContainer();
+  pcl::Indices before;
+  container.getPointIndices(before);
+  container.addPointIndex(12345);
+  pcl::Indices after;
+  container.getPointIndices(after);
+  before.push_back(12345);
+  EXPECT_EQ(after, before);
+  EXPECT_EQ(container.getPointIndex(), 12345);
+  pcl::selective_seg::OctreeNormalVarianceContainer same(container);
+  EXPECT_TRUE(same == container);
+  container.reset();
+  EXPECT_EQ(container.getSize(), 0u);
+  EXPECT_FALSE(same == container);
 }
 
 TEST(OctreePointCloudNormalVariance, VoxelGeometry)

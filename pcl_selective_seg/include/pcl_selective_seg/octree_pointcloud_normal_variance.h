@@ -170,6 +170,9 @@ private:
   NormalVectorsConstPtr normal_vectors_;
   AreasConstPtr areas_;
   Eigen::Quaternionf sensor_orientation_ = Eigen::Quaternionf::Identity();
+  /** The indices of the leaves built by addPointsFromInputCloud(), leaf after leaf;
+   * their containers view them. Assigned only while the tree is empty. */
+  pcl::Indices voxel_indices_;
   pcl::Indices ordered_indices_;
   std::vector<Eigen::Vector3d> ordered_normals_; ///< sensor frame, reversed (eq. 5)
   std::vector<double> ordered_theta_;            ///< angles of ordered_normals_ [rad]

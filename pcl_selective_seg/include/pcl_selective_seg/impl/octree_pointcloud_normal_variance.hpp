@@ -178,6 +178,13 @@ OctreePointCloudNormalVariance<PointT>::addPointsFromInputCloud()
     return true;
   }
   detail::radixSortByKey(order, static_cast<int>(3 * depth), num_threads_);
+  // The leaves' indices, in one array that each leaf container views.
+  voxel_indices_.resize(order.size());
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(num_threads_) schedule(static)
+#endif
+  for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(order.size()); ++k)
+    voxel_indices_[k] = order[k].second;
   // The same tree as PCL's point-by-point insertion (addPointIdx()), built along the
   // sorted codes: consecutive voxels share the branches of their common prefix, so
   // each node is created once, from its parent, and each leaf's indices are stored
@@ -204,10 +211,8 @@ OctreePointCloudNormalVariance<PointT>::addPointsFromInputCloud()
     }
     LeafNode* leaf = this->createLeafChild(*path[depth - 1], child(depth - 1));
     ++this->leaf_count_;
-    auto& indices = leaf->getContainer().getPointIndicesVector();
-    indices.reserve(end - begin);
-    for (std::size_t k = begin; k < end; ++k)
-      indices.push_back(order[k].second);
+    leaf->getContainer().viewPointIndices(voxel_indices_.data() + begin,
+                                          static_cast<pcl::uindex_t>(end - begin));
     begin = end;
   }
   return true;
@@ -221,8 +226,7 @@ OctreePointCloudNormalVariance<PointT>::orderPoints(const pcl::octree::OctreeNod
     auto& container =
         const_cast<LeafNode*>(static_cast<const LeafNode*>(node))->getContainer();
     container.setFirstOrderedPoint(ordered_indices_.size());
-    const auto& indices = container.getPointIndicesVector();
-    ordered_indices_.insert(ordered_indices_.end(), indices.begin(), indices.end());
+    ordered_indices_.insert(ordered_indices_.end(), container.begin(), container.end());
     return;
   }
   const auto* branch = static_cast<const BranchNode*>(node);
