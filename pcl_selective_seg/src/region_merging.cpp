@@ -340,9 +340,9 @@ public:
 
   /** The seeds in order, each unassigned one growing a segment.
    *
-   * On several threads (enough leaves), the order is taken in windows of kWindow
-   * seeds. In a window, each thread first grows the window's seeds of its part of the
-   * leaves (a range of octree order, a region of space), over the state the previous
+   * On several threads (enough leaves), the order is taken in windows of at most
+   * kWindow seeds. In a window, each thread first grows the window's seeds of its part
+   * of the leaves (a range of octree order, a region of space), over the state the previous
    * windows left plus its own segments of this window, as if the other parts' seeds of
    * the window did not exist; it notes the leaves each segment claimed and those it
    * found held by its own earlier segments of the window. Then, in seed order, a grown
@@ -383,8 +383,9 @@ public:
       a.overlay.assign(num_leaves, 0);
       a.noted.assign(num_leaves, 0);
     }
-    for (std::size_t w = 0; w < order.size(); w += kWindow) {
-      const std::size_t w_end = std::min(order.size(), w + kWindow);
+    std::size_t window = kFirstWindow;
+    for (std::size_t w = 0; w < order.size();) {
+      const std::size_t w_end = std::min(order.size(), w + window);
 #ifdef _OPENMP
 #pragma omp parallel for num_threads(static_cast<int>(parts)) schedule(static, 1)
 #endif
@@ -422,6 +423,8 @@ public:
       for (auto& a : ahead)
         for (const auto l : a.claimed)
           a.overlay[l] = 0;
+      w = w_end;
+      window = std::min(2 * window, kWindow);
     }
   }
 
@@ -430,6 +433,10 @@ private:
   static constexpr std::size_t kMinParallelLeaves = 1024;
   /** Seeds per window (window-local ids fit the overlay's 16 bits). */
   static constexpr std::size_t kWindow = 4096;
+  /** The first window; each next one twice as long, up to kWindow. The largest seeds
+   * come first and often grow the largest segments: in short windows, these are
+   * committed before the threads grow the seeds around them. */
+  static constexpr std::size_t kFirstWindow = 8;
 
   /** Grow the seeds order[w, w_end) that lie in [first, last), in order. */
   void speculate(const std::vector<pcl::index_t>& order,
