@@ -342,9 +342,9 @@ public:
    *
    * On several threads (enough leaves), the order is taken in windows of at most
    * kWindow seeds. In a window, each thread first grows the window's seeds of its part
-   * of the leaves (a range of octree order, a region of space), over the state the previous
-   * windows left plus its own segments of this window, as if the other parts' seeds of
-   * the window did not exist; it notes the leaves each segment claimed and those it
+   * of the leaves (a range of octree order, a region of space), over the state the
+   * previous windows left plus its own segments of this window, as if the other parts'
+   * seeds of the window did not exist; it notes the leaves each segment claimed and those it
    * found held by its own earlier segments of the window. Then, in seed order, a grown
    * segment is taken as is when its growth met the state the sequential run meets:
    * each leaf it claimed is still free, and each leaf it found held is held. The
