@@ -344,16 +344,16 @@ public:
    * kWindow seeds. In a window, each thread first grows the window's seeds of its part
    * of the leaves (a range of octree order, a region of space), over the state the
    * previous windows left plus its own segments of this window, as if the other parts'
-   * seeds of the window did not exist; it notes the leaves each segment claimed and those it
-   * found held by its own earlier segments of the window. Then, in seed order, a grown
-   * segment is taken as is when its growth met the state the sequential run meets:
-   * each leaf it claimed is still free, and each leaf it found held is held. The
+   * seeds of the window did not exist; it notes the leaves each segment claimed and
+   * those it found held by its own earlier segments of the window. Then, in seed order,
+   * a grown segment is taken as is when its growth met the state the sequential run
+   * meets: each leaf it claimed is still free, and each leaf it found held is held. The
    * growth reads nothing else that can differ (which segment holds a leaf never
    * matters, only whether it is this one, and a free leaf that a test turned down is
    * left alone whether free or held), so it makes the same decisions in the same order
    * and ends with the same normal. Otherwise the segment grows again there, over the
-   * true state. The result is the sequential run's, bit for bit, for any thread
-   * count; the windows bound the memory the threads' notes take. */
+   * true state. The result is the sequential run's, bit for bit, for any thread count;
+   * the windows bound the memory the threads' notes take. */
   void run(std::vector<pcl::index_t>& leaf_segment, Vector3fVector& segment_normals)
   {
     const std::size_t num_leaves = numLeaves(in_);
