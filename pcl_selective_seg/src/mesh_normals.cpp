@@ -17,6 +17,7 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <memory>
 
 namespace pcl {
 namespace selective_seg {
@@ -571,7 +572,9 @@ medianEdgeLength(const Vector3fVector& positions,
   // The median of the squared lengths, then one square root: sqrt is monotone and
   // correctly rounded, and Eigen's norm() is sqrt(squaredNorm()), so this is the
   // median of the lengths to the bit.
-  std::vector<double> squares(3 * static_cast<std::size_t>(sampled));
+  // Every entry is written below: no zero fill.
+  const std::size_t num_squares = 3 * static_cast<std::size_t>(sampled);
+  const std::unique_ptr<double[]> squares(new double[num_squares]);
   // Squares are non-negative, so their bit patterns order as they do: the range of the
   // patterns, then a histogram over it, finds the bucket that holds the element of rank
   // n / 2, and only that bucket is partitioned.
@@ -602,8 +605,7 @@ medianEdgeLength(const Vector3fVector& positions,
   while (((highest - lowest) >> shift) >= 4096)
     ++shift;
   const auto bucketOf = [&](double v) { return (bits(v) - lowest) >> shift; };
-  const std::size_t rank = squares.size() / 2;
-  const auto num_squares = static_cast<std::ptrdiff_t>(squares.size());
+  const std::size_t rank = num_squares / 2;
   const bool parallel = static_cast<std::size_t>(sampled) >= detail::kMinParallelItems;
   const int num_parts = parallel ? threads(num_threads) : 1;
   std::vector<std::uint32_t> histograms(4096 * static_cast<std::size_t>(num_parts), 0);
@@ -617,7 +619,7 @@ medianEdgeLength(const Vector3fVector& positions,
 #else
     std::uint32_t* histogram = histograms.data();
 #endif
-    for (std::ptrdiff_t k = 0; k < num_squares; ++k)
+    for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(num_squares); ++k)
       ++histogram[bucketOf(squares[k])];
   }
   for (int p = 1; p < num_parts; ++p)
@@ -638,7 +640,7 @@ medianEdgeLength(const Vector3fVector& positions,
 #ifdef _OPENMP
 #pragma omp for schedule(static) nowait
 #endif
-    for (std::ptrdiff_t k = 0; k < num_squares; ++k)
+    for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(num_squares); ++k)
       if (bucketOf(squares[k]) == bucket)
         mine.push_back(squares[k]);
 #ifdef _OPENMP

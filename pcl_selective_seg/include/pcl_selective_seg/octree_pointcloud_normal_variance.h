@@ -17,10 +17,45 @@
 #include <limits>
 #include <memory>
 #include <thread>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace pcl {
 namespace selective_seg {
+namespace detail {
+
+/** \brief std::allocator whose resize() leaves new elements default-initialized (so
+ * trivial ones not written), for scratch arrays that are written in full right after,
+ * in parallel: the zero fill would be a sequential pass over them. */
+template <typename T>
+struct DefaultInitAllocator : std::allocator<T> {
+  template <typename U>
+  struct rebind {
+    using other = DefaultInitAllocator<U>;
+  };
+  DefaultInitAllocator() = default;
+  template <typename U>
+  DefaultInitAllocator(const DefaultInitAllocator<U>&) noexcept
+  {
+  }
+  template <typename U>
+  void construct(U* p) noexcept(std::is_nothrow_default_constructible<U>::value)
+  {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <typename U, typename... Args>
+  void construct(U* p, Args&&... args)
+  {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
+};
+
+/** \brief A scratch array whose resize() does not zero its elements. */
+template <typename T>
+using ScratchVector = std::vector<T, DefaultInitAllocator<T>>;
+
+} // namespace detail
 
 /** \brief Multi-resolution octree whose voxels split while their normals vary (paper,
  * Sec. III.C, eq. 3-5).
@@ -174,10 +209,10 @@ private:
    * their containers view them. Assigned only while the tree is empty. */
   pcl::Indices voxel_indices_;
   pcl::Indices ordered_indices_;
-  std::vector<Eigen::Vector3d> ordered_normals_; ///< sensor frame, reversed (eq. 5)
-  std::vector<double> ordered_theta_;            ///< angles of ordered_normals_ [rad]
-  std::vector<double> ordered_phi_;
-  std::vector<double> ordered_weights_; ///< 1 / A_p (eq. 4)
+  detail::ScratchVector<Eigen::Vector3d> ordered_normals_; ///< sensor frame, reversed
+  detail::ScratchVector<double> ordered_theta_; ///< angles of ordered_normals_ [rad]
+  detail::ScratchVector<double> ordered_phi_;
+  detail::ScratchVector<double> ordered_weights_; ///< 1 / A_p (eq. 4)
   std::vector<AdaptiveLeaf> leaves_;
   unsigned int num_threads_ = std::max(1u, std::thread::hardware_concurrency());
 };

@@ -453,10 +453,10 @@ template <typename PointT>
 void
 OctreePointCloudNormalVariance<PointT>::releaseScratch()
 {
-  std::vector<Eigen::Vector3d>().swap(ordered_normals_);
-  std::vector<double>().swap(ordered_theta_);
-  std::vector<double>().swap(ordered_phi_);
-  std::vector<double>().swap(ordered_weights_);
+  decltype(ordered_normals_)().swap(ordered_normals_);
+  decltype(ordered_theta_)().swap(ordered_theta_);
+  decltype(ordered_phi_)().swap(ordered_phi_);
+  decltype(ordered_weights_)().swap(ordered_weights_);
 }
 
 template <typename PointT>

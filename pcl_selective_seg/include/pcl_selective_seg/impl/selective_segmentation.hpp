@@ -475,16 +475,21 @@ SelectiveSegmentation<PointT>::mergeAndLabel()
   Vector3fVector segment_normals;
   mergeSeedSegments(in, leaf_segment, segment_normals);
 
-  std::vector<pcl::index_t> vertex_segment(vertex_leaf_.size(), -1);
-  for (std::size_t v = 0; v < vertex_leaf_.size(); ++v)
-    if (vertex_leaf_[v] >= 0)
-      vertex_segment[v] = leaf_segment[vertex_leaf_[v]];
+  const auto num_vertices = static_cast<std::ptrdiff_t>(vertex_leaf_.size());
+  std::vector<pcl::index_t> vertex_segment(vertex_leaf_.size());
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(numThreads()) schedule(static)
+#endif
+  for (std::ptrdiff_t v = 0; v < num_vertices; ++v)
+    vertex_segment[v] = vertex_leaf_[v] >= 0 ? leaf_segment[vertex_leaf_[v]] : -1;
   std::vector<std::uint32_t> segment_label;
   rankSegments(vertex_segment, segment_normals, segment_label);
-  std::vector<std::uint32_t> vertex_labels(vertex_segment.size(), 0);
-  for (std::size_t v = 0; v < vertex_segment.size(); ++v)
-    if (vertex_segment[v] >= 0)
-      vertex_labels[v] = segment_label[vertex_segment[v]];
+  std::vector<std::uint32_t> vertex_labels(vertex_segment.size());
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(numThreads()) schedule(static)
+#endif
+  for (std::ptrdiff_t v = 0; v < num_vertices; ++v)
+    vertex_labels[v] = vertex_segment[v] >= 0 ? segment_label[vertex_segment[v]] : 0;
   fillMeshAndLeaves(vertex_labels, leaf_segment, segment_label);
 }
 
