@@ -165,7 +165,7 @@ BM_RegionGrowing_Mug(benchmark::State& state)
   runRegionGrowing(state, realFrame("pcl_test/table_scene_mug_stereo_textured.pcd"));
 }
 
-/** Sizes: small ones repeated for a median, the largest run once. */
+/** Sizes of the simulated door scans. */
 void
 sizes(benchmark::internal::Benchmark* b, bool include_3m)
 {
@@ -187,7 +187,9 @@ BENCHMARK(BM_RegionGrowing_Door)
     ->Apply([](benchmark::internal::Benchmark* b) { sizes(b, true); })
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
-    ->Iterations(1);
+    ->Iterations(1)
+    ->Repetitions(3)
+    ->ReportAggregatesOnly(true);
 BENCHMARK(BM_Pipeline_Mosd)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
@@ -196,7 +198,9 @@ BENCHMARK(BM_Pipeline_Mosd)
 BENCHMARK(BM_RegionGrowing_Mosd)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
-    ->Iterations(1);
+    ->Iterations(1)
+    ->Repetitions(3)
+    ->ReportAggregatesOnly(true);
 BENCHMARK(BM_Pipeline_Mug)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
@@ -205,6 +209,8 @@ BENCHMARK(BM_Pipeline_Mug)
 BENCHMARK(BM_RegionGrowing_Mug)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
-    ->Iterations(1);
+    ->Iterations(1)
+    ->Repetitions(3)
+    ->ReportAggregatesOnly(true);
 
 BENCHMARK_MAIN();
