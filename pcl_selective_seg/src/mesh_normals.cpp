@@ -157,7 +157,7 @@ computeTriangleNormalsAndEdgeOn(const Vector3fVector& positions,
   const double min_cos = minIncidenceCos(max_incidence);
   const Eigen::Vector3d eye = viewpoint.cast<double>();
   const auto n_tri = static_cast<std::ptrdiff_t>(triangles.size());
-#pragma omp parallel for num_threads(threads(num_threads)) schedule(static)
+#pragma omp parallel for num_threads(threads(num_threads)) schedule(dynamic, 1024)
   for (std::ptrdiff_t t = 0; t < n_tri; ++t) {
     triangleNormal(positions, triangles[t], eye, normals[t], areas[t]);
     edge_on[t] = isEdgeOn(positions, triangles[t], normals[t], eye, min_cos);

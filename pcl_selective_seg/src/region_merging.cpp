@@ -520,7 +520,7 @@ classifyTriangles(const std::vector<Triangle>& triangles,
   const auto num_triangles = static_cast<std::ptrdiff_t>(triangles.size());
   // Each triangle's label and class are its own: the same for any thread count.
 #ifdef _OPENMP
-#pragma omp parallel for num_threads(threads) schedule(static)
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 1024)
 #endif
   for (std::ptrdiff_t t = 0; t < num_triangles; ++t) {
     const auto& tri = triangles[t];

@@ -247,7 +247,7 @@ OctreePointCloudNormalVariance<PointT>::computeNormalAngles()
   const Eigen::Matrix3d to_sensor =
       sensor_orientation_.toRotationMatrix().transpose().template cast<double>();
 #ifdef _OPENMP
-#pragma omp parallel for num_threads(num_threads_) schedule(static)
+#pragma omp parallel for num_threads(num_threads_) schedule(dynamic, 1024)
 #endif
   for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(n); ++k) {
     // The points are in Morton order, their normals and areas in vertex order: ask for

@@ -114,7 +114,7 @@ SphericalDelaunay<PointT>::projectAndMergeVertices(SphericalTriangulation& resul
   // (angle key, point index), one per index; computed in parallel, point by point.
   std::vector<std::pair<std::uint64_t, pcl::index_t>> keyed(indices.size());
 #ifdef _OPENMP
-#pragma omp parallel for num_threads(num_threads_) schedule(static)
+#pragma omp parallel for num_threads(num_threads_) schedule(dynamic, 1024)
 #endif
   for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(indices.size()); ++k)
     keyed[k] = projectPoint(pose, indices[k]);
