@@ -47,11 +47,8 @@ angleDeg(const Eigen::Vector3f& a, const Eigen::Vector3f& b)
   return std::acos(std::max(-1.0, std::min(1.0, c))) / kDeg;
 }
 
-/** A strip of 2 x n vertices. Column c holds vertices 2c and 2c + 1; triangles
- * (2c, 2c + 1, 2c + 2) and (2c + 1, 2c + 3, 2c + 2), numbered 2c and 2c + 1, join it to
- * column c + 1. Each column belongs to one leaf (-1: none). A triangle within one leaf
- * gets the leaf's normal, a triangle between two leaves the normal half way between. */
-struct Strip {
+/** Seeds and a mesh as mergeSeedSegments() takes them. */
+struct SeededMesh {
   Vector3fVector leaf_normals;
   std::vector<double> leaf_areas;
   std::vector<pcl::index_t> vertex_leaf;
@@ -59,11 +56,32 @@ struct Strip {
   Vector3fVector triangle_normals;
   std::vector<std::uint8_t> edge_on;
 
+  MergeInput input(int threads = 1) const
+  {
+    MergeInput in;
+    in.leaf_normals = &leaf_normals;
+    in.leaf_areas = &leaf_areas;
+    in.vertex_leaf = &vertex_leaf;
+    in.triangles = &triangles;
+    in.triangle_normals = &triangle_normals;
+    in.triangle_edge_on = &edge_on;
+    in.max_merge_angle = kThreshold;
+    in.max_edge_triangle_angle = kThreshold;
+    in.num_threads = threads;
+    return in;
+  }
+};
+
+/** A strip of 2 x n vertices. Column c holds vertices 2c and 2c + 1; triangles
+ * (2c, 2c + 1, 2c + 2) and (2c + 1, 2c + 3, 2c + 2), numbered 2c and 2c + 1, join it to
+ * column c + 1. Each column belongs to one leaf (-1: none). A triangle within one leaf
+ * gets the leaf's normal, a triangle between two leaves the normal half way between. */
+struct Strip : SeededMesh {
   Strip(const std::vector<pcl::index_t>& column_leaf,
         const std::vector<double>& leaf_degrees,
         const std::vector<double>& areas)
-      : leaf_areas(areas)
   {
+    leaf_areas = areas;
     for (const double d : leaf_degrees)
       leaf_normals.push_back(tilted(d));
     for (const auto leaf : column_leaf) {
@@ -93,19 +111,6 @@ struct Strip {
     triangle_normals[2 * c + 1] = normal;
   }
 
-  MergeInput input() const
-  {
-    MergeInput in;
-    in.leaf_normals = &leaf_normals;
-    in.leaf_areas = &leaf_areas;
-    in.vertex_leaf = &vertex_leaf;
-    in.triangles = &triangles;
-    in.triangle_normals = &triangle_normals;
-    in.triangle_edge_on = &edge_on;
-    in.max_merge_angle = kThreshold;
-    in.max_edge_triangle_angle = kThreshold;
-    return in;
-  }
 };
 
 struct Merged {
@@ -329,21 +334,14 @@ TEST(MergeSeedSegments, TriangleOverThreeSeeds)
 {
   // One triangle whose vertices lie in three one-vertex seeds; a fourth seed has no
   // vertex at all and still gets a segment of its own.
-  const Vector3fVector leaf_normals{
-      tilted(0.0), tilted(10.0), tilted(-10.0), tilted(0.0)};
-  const std::vector<double> leaf_areas{1.0, 1.0, 1.0, 1.0};
-  const std::vector<pcl::index_t> vertex_leaf{0, 1, 2};
-  const std::vector<Triangle> triangles{{0, 1, 2}};
-  const Vector3fVector triangle_normals{tilted(0.0)};
-  MergeInput in;
-  in.leaf_normals = &leaf_normals;
-  in.leaf_areas = &leaf_areas;
-  in.vertex_leaf = &vertex_leaf;
-  in.triangles = &triangles;
-  in.triangle_normals = &triangle_normals;
-  in.max_merge_angle = kThreshold;
-  in.max_edge_triangle_angle = kThreshold;
-  const Merged m = merge(in);
+  SeededMesh mesh;
+  mesh.leaf_normals = {tilted(0.0), tilted(10.0), tilted(-10.0), tilted(0.0)};
+  mesh.leaf_areas = {1.0, 1.0, 1.0, 1.0};
+  mesh.vertex_leaf = {0, 1, 2};
+  mesh.triangles = {{0, 1, 2}};
+  mesh.triangle_normals = {tilted(0.0)};
+  mesh.edge_on = {0};
+  const Merged m = merge(mesh.input());
   EXPECT_EQ(m.leaf_segment, (Segments{0, 0, 0, 1}));
   ASSERT_EQ(m.segment_normals.size(), 2u);
   EXPECT_NEAR(angleDeg(m.segment_normals[0], tilted(0.0)), 0.0, 1e-3);
@@ -354,14 +352,7 @@ TEST(MergeSeedSegments, TriangleOverThreeSeeds)
  * noise (segments of many sizes, some across the whole grid), triangle normals from
  * their leaves with noise, a few degenerate (NaN) and edge-on triangles, and some
  * vertices in no leaf. */
-struct NoisyGrid {
-  Vector3fVector leaf_normals;
-  std::vector<double> leaf_areas;
-  std::vector<pcl::index_t> vertex_leaf;
-  std::vector<Triangle> triangles;
-  Vector3fVector triangle_normals;
-  std::vector<std::uint8_t> edge_on;
-
+struct NoisyGrid : SeededMesh {
   NoisyGrid(int n, int b, bool shuffle_leaves, unsigned seed)
   {
     std::mt19937 rng(seed);
@@ -412,20 +403,6 @@ struct NoisyGrid {
     }
   }
 
-  MergeInput input(int threads) const
-  {
-    MergeInput in;
-    in.leaf_normals = &leaf_normals;
-    in.leaf_areas = &leaf_areas;
-    in.vertex_leaf = &vertex_leaf;
-    in.triangles = &triangles;
-    in.triangle_normals = &triangle_normals;
-    in.triangle_edge_on = &edge_on;
-    in.max_merge_angle = kThreshold;
-    in.max_edge_triangle_angle = kThreshold;
-    in.num_threads = threads;
-    return in;
-  }
 };
 
 // The growth of many seeds runs on several threads, each growing the seeds of its part
