@@ -360,8 +360,10 @@ public:
     leaf_segment.assign(num_leaves, -1);
     segment_normals.clear();
     const std::vector<pcl::index_t> order = seedOrder(*in_.vertex_leaf, num_leaves);
-    const std::size_t parts = static_cast<std::size_t>(
-        in_.num_threads > 0 ? in_.num_threads : static_cast<int>(defaultThreads()));
+    const int threads =
+        in_.num_threads > 0 ? in_.num_threads : static_cast<int>(defaultThreads());
+    const std::size_t parts =
+        std::min<std::size_t>(kMaxParts, static_cast<std::size_t>(threads));
     SegmentGrowth growth(in_, adjacency_);
     const auto growHere = [&](pcl::index_t seed) {
       const auto k = static_cast<pcl::index_t>(segment_normals.size());
@@ -431,6 +433,9 @@ public:
 private:
   /** Below this many leaves the growth runs on one thread. */
   static constexpr std::size_t kMinParallelLeaves = 1024;
+  /** At most this many parts (threads) grow ahead: each holds 3 bytes per leaf, and
+   * more parts meet more often at their borders. */
+  static constexpr std::size_t kMaxParts = 8;
   /** Seeds per window (window-local ids fit the overlay's 16 bits). */
   static constexpr std::size_t kWindow = 4096;
   /** The first window; each next one twice as long, up to kWindow. The largest seeds
