@@ -161,6 +161,9 @@ TEST(SelectiveSegmentation, ThreadCountDoesNotChangeTheResult)
     all_clusters.push_back(clusters);
   }
   ASSERT_GT(results[0].mesh.triangles.size(), 65536u);
+  // Enough leaves for the seed growth to run ahead on the threads (from 1,024), over
+  // several windows.
+  ASSERT_GT(results[0].leaves.size(), 4096u);
   // Each cluster: its points in increasing order, all with its label.
   for (std::size_t r = 0; r < all_clusters[0].size(); ++r) {
     const auto& indices = all_clusters[0][r].indices;
@@ -174,6 +177,9 @@ TEST(SelectiveSegmentation, ThreadCountDoesNotChangeTheResult)
     for (std::size_t r = 0; r < all_clusters[0].size(); ++r)
       ASSERT_EQ(all_clusters[0][r].indices, all_clusters[k][r].indices);
     EXPECT_EQ(results[0].labels, results[k].labels);
+    ASSERT_EQ(results[0].segments.size(), results[k].segments.size());
+    for (std::size_t s = 0; s < results[0].segments.size(); ++s)
+      EXPECT_TRUE(results[0].segments[s].normal == results[k].segments[s].normal);
     EXPECT_EQ(results[0].mesh.triangles, results[k].mesh.triangles);
     EXPECT_EQ(results[0].mesh.neighbours, results[k].mesh.neighbours);
     EXPECT_EQ(results[0].mesh.labels, results[k].mesh.labels);
