@@ -201,39 +201,39 @@ struct SharedState {
 
   bool claimed(pcl::index_t l) const { return leaf_segment[l] >= 0; }
   bool own(pcl::index_t l) const { return leaf_segment[l] == k; }
-  /** Held by another segment, and to be noted (never here). */
-  bool noteHeld(pcl::index_t) const { return false; }
+  /** A held leaf met (nothing to note here). */
+  void metHeld(pcl::index_t) const {}
   void claim(pcl::index_t l) { leaf_segment[l] = k; }
 };
 
 /** A thread's view while it grows seeds ahead of their turn: the shared state as the
  * last window left it (read only), plus the segments this thread grew in this window
- * (an overlay of window-local ids + 1; 0: none). */
+ * (an overlay of window-local ids + 1; 0: none). The leaves the growth finds held by
+ * another segment of this window go, once each, to \a held: with the leaves it claimed,
+ * all that its outcome depends on besides the input (see SeedMerger::run()). */
 struct OverlayState {
   const std::vector<pcl::index_t>& leaf_segment;
   std::vector<std::uint16_t>& overlay;
-  std::vector<std::uint8_t>& noted; ///< leaves already noted for this segment
-  std::uint16_t k;                  ///< the growing segment's window-local id + 1
+  std::vector<std::uint8_t>& noted; ///< leaves already in held for this segment
+  std::vector<pcl::index_t>& held;
+  std::uint16_t k; ///< the growing segment's window-local id + 1
 
   bool claimed(pcl::index_t l) const { return leaf_segment[l] >= 0 || overlay[l] != 0; }
   bool own(pcl::index_t l) const { return overlay[l] == k; }
-  /** Whether l is held by another segment of this window and not yet noted (a leaf
-   * held in the shared state stays held: nothing to check). */
-  bool noteHeld(pcl::index_t l)
+  /** A held leaf met: noted when another segment of this window holds it (a leaf held
+   * in the shared state stays held: nothing to check). */
+  void metHeld(pcl::index_t l)
   {
     if (leaf_segment[l] >= 0 || overlay[l] == k || noted[l])
-      return false;
+      return;
     noted[l] = 1;
-    return true;
+    held.push_back(l);
   }
   void claim(pcl::index_t l) { overlay[l] = k; }
 };
 
 /** The growth of one segment from its seed (eq. 7-10) over a state that says which
- * leaves are claimed and which are this segment's. With a record, it also notes, once
- * each, the leaves it met held by another segment of the same window: with the leaves
- * it claimed (queue()), all that its outcome depends on besides the input (see
- * SeedMerger::run()). */
+ * leaves are claimed and which are this segment's, and hears of the held leaves met. */
 class SegmentGrowth {
 public:
   SegmentGrowth(const MergeInput& in, const LeafTriangles& adjacency)
@@ -246,7 +246,7 @@ public:
 
   template <typename State>
   Eigen::Vector3d
-  grow(pcl::index_t seed, State& state, std::vector<pcl::index_t>* held = nullptr)
+  grow(pcl::index_t seed, State& state)
   {
     GrowingSegment segment;
     segment.add(leafNormal(in_, seed), leafArea(in_, seed));
@@ -262,7 +262,7 @@ public:
           const pcl::index_t ahead = adjacency_.entries[i + 8].triangle;
           __builtin_prefetch(&(*in_.triangle_normals)[ahead]);
         }
-        visitTriangle(adjacency_.entries[i], segment, state, held);
+        visitTriangle(adjacency_.entries[i], segment, state);
       }
     }
     return segment.normal;
@@ -273,10 +273,7 @@ public:
 
 private:
   template <typename State>
-  void visitTriangle(const LeafTriangle& entry,
-                     GrowingSegment& segment,
-                     State& state,
-                     std::vector<pcl::index_t>* held)
+  void visitTriangle(const LeafTriangle& entry, GrowingSegment& segment, State& state)
   {
     const auto& leaves = entry.leaves;
     const pcl::index_t t = entry.triangle;
@@ -289,8 +286,7 @@ private:
       if (other < 0)
         continue;
       if (state.claimed(other)) {
-        if (held && state.noteHeld(other))
-          held->push_back(other);
+        state.metHeld(other);
         continue;
       }
       const Eigen::Vector3f& n_other = leafNormal(in_, other);
@@ -463,11 +459,11 @@ private:
           out.overlay[seed] != 0)
         continue;
       const auto k = static_cast<std::uint16_t>(out.segments.size() + 1);
-      OverlayState state{leaf_segment, out.overlay, out.noted, k};
+      OverlayState state{leaf_segment, out.overlay, out.noted, out.held, k};
       const std::size_t held_begin = out.held.size();
       Speculation::Segment s;
       s.seed = seed;
-      s.normal = growth.grow(seed, state, &out.held);
+      s.normal = growth.grow(seed, state);
       for (std::size_t h = held_begin; h < out.held.size(); ++h)
         out.noted[out.held[h]] = 0;
       const auto& queue = growth.queue();
