@@ -600,21 +600,23 @@ medianEdgeLength(const Vector3fVector& positions,
       highest = std::max(highest, bits(square));
     }
   }
-  // 4,096 buckets over [lowest, highest]; a histogram per thread, then their sum.
+  // kBuckets buckets over [lowest, highest]; a histogram per thread, then their sum.
+  constexpr std::size_t kBuckets = 4096;
   int shift = 0;
-  while (((highest - lowest) >> shift) >= 4096)
+  while (((highest - lowest) >> shift) >= kBuckets)
     ++shift;
   const auto bucketOf = [&](double v) { return (bits(v) - lowest) >> shift; };
   const std::size_t rank = num_squares / 2;
   const bool parallel = static_cast<std::size_t>(sampled) >= detail::kMinParallelItems;
   const int num_parts = parallel ? threads(num_threads) : 1;
-  std::vector<std::uint32_t> histograms(4096 * static_cast<std::size_t>(num_parts), 0);
+  std::vector<std::uint32_t> histograms(kBuckets * static_cast<std::size_t>(num_parts),
+                                        0);
 #ifdef _OPENMP
 #pragma omp parallel num_threads(num_parts) if (parallel)
 #endif
   {
 #ifdef _OPENMP
-    std::uint32_t* histogram = histograms.data() + 4096 * omp_get_thread_num();
+    std::uint32_t* histogram = histograms.data() + kBuckets * omp_get_thread_num();
 #pragma omp for schedule(static)
 #else
     std::uint32_t* histogram = histograms.data();
@@ -623,8 +625,8 @@ medianEdgeLength(const Vector3fVector& positions,
       ++histogram[bucketOf(squares[k])];
   }
   for (int p = 1; p < num_parts; ++p)
-    for (std::size_t b = 0; b < 4096; ++b)
-      histograms[b] += histograms[4096 * static_cast<std::size_t>(p) + b];
+    for (std::size_t b = 0; b < kBuckets; ++b)
+      histograms[b] += histograms[kBuckets * static_cast<std::size_t>(p) + b];
   std::size_t below = 0;
   std::uint64_t bucket = 0;
   while (below + histograms[bucket] <= rank)

@@ -6,6 +6,7 @@
 
 #pragma once
 
+#include <pcl_selective_seg/delaunay_2d.h>
 #include <pcl_selective_seg/impl/radix_sort.hpp>
 #include <pcl_selective_seg/octree_pointcloud_normal_variance.h>
 
@@ -108,7 +109,8 @@ OctreePointCloudNormalVariance<PointT>::addPointsFromInputCloud()
   Eigen::Array3d lo = Eigen::Array3d::Constant(std::numeric_limits<double>::max());
   Eigen::Array3d hi = -lo;
 #ifdef _OPENMP
-#pragma omp parallel num_threads(num_threads_) if (num_candidates >= 4096)
+#pragma omp parallel num_threads(num_threads_)                                        \
+    if (static_cast<std::size_t>(num_candidates) >= detail::kMinParallelItems)
 #endif
   {
     Eigen::Array3d my_lo = lo, my_hi = hi;
