@@ -44,10 +44,14 @@ without(const Points& base, Points extra)
   return out;
 }
 
-/** Inserts \a extra into the triangulation of \a base and checks every output against
- * a from-scratch triangulation of the union. Returns the insertion record. */
+/** Inserts \a extra into the triangulation of \a base on \a threads threads and checks
+ * every output against a from-scratch triangulation of the union. Returns the
+ * insertion record. */
 DelaunayInsertion
-insertAndCompare(const Points& base_in, const Points& extra_in, std::mt19937& rng)
+insertAndCompare(const Points& base_in,
+                 const Points& extra_in,
+                 std::mt19937& rng,
+                 unsigned int threads = 1)
 {
   const Points base = sortedUnique(base_in);
   Points extra = without(base, extra_in);
@@ -61,7 +65,7 @@ insertAndCompare(const Points& base_in, const Points& extra_in, std::mt19937& rn
   DelaunayInsertion info;
   std::string why;
   EXPECT_TRUE(pcl::selective_seg::insertDelaunayPoints(
-      points, triangles, neighbours, extra, info, &why))
+      points, triangles, neighbours, extra, info, &why, threads))
       << why;
 
   Points all = base;
@@ -196,6 +200,29 @@ TEST(DelaunayInsertion, ScanLikeColumnsRefinedInAWindow)
       extra.push_back({c * 500 + 250 + static_cast<std::int32_t>(jitter(rng)),
                        r * 500 + 250 + static_cast<std::int32_t>(jitter(rng))});
   insertAndCompare(base, extra, rng);
+}
+
+TEST(DelaunayInsertion, SameResultForAnyThreadCount)
+{
+  // Large enough (over 16,384 old points and triangles) for the renumbering, assembly
+  // and adjacency passes to split into chunks; several windows, one of them a grid
+  // over a grid (co-circular squares), and points outside the hull.
+  std::mt19937 rng(8);
+  Points base = uniform(30000, -3000000, 3000000, rng);
+  const Points lattice = grid(1000000, 1400000, 1000000, 1300000, 10000);
+  base.insert(base.end(), lattice.begin(), lattice.end());
+  Points extra = uniform(1500, -200000, 200000, rng);
+  const Points left = uniform(800, -2900000, -2700000, rng);
+  const Points finer = grid(1100000, 1300000, 1100000, 1200000, 5000);
+  const Points outside = uniform(300, 3000001, 3100000, rng);
+  for (const Points* more : {&left, &finer, &outside})
+    extra.insert(extra.end(), more->begin(), more->end());
+  for (const unsigned int threads : {1u, 2u, 3u}) {
+    SCOPED_TRACE(threads);
+    std::mt19937 order(9); // the same shuffle of the new points each time
+    const auto info = insertAndCompare(base, extra, order, threads);
+    EXPECT_GT(info.replaced_triangles, 1000u);
+  }
 }
 
 TEST(DelaunayInsertion, RejectsBadInputWithoutChangingIt)

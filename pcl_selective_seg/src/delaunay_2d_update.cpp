@@ -19,12 +19,17 @@
 // Euler's count over the whole mesh) before it replaces the input.
 
 #include <pcl_selective_seg/delaunay_2d_update.h>
+#include <pcl_selective_seg/impl/radix_sort.hpp>
 
 #include "delaunay_2d_backends.h"
 
 #include <algorithm>
 #include <cstdint>
 #include <unordered_map>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 namespace pcl {
 namespace selective_seg {
@@ -43,6 +48,90 @@ struct HullEdge {
   int opposite = 0;
 };
 
+/** Bits 0..26 of \a x spread to the even bits. */
+std::uint64_t
+spreadBits(std::uint64_t x)
+{
+  x &= (std::uint64_t{1} << 27) - 1;
+  x = (x | (x << 16)) & 0x0000FFFF0000FFFFull;
+  x = (x | (x << 8)) & 0x00FF00FF00FF00FFull;
+  x = (x | (x << 4)) & 0x0F0F0F0F0F0F0F0Full;
+  x = (x | (x << 2)) & 0x3333333333333333ull;
+  x = (x | (x << 1)) & 0x5555555555555555ull;
+  return x;
+}
+
+/** The order in which to locate the points \a q: along a Z-order curve over their
+ * coordinates, so that each walk starts from a nearby point's triangle. (In the
+ * lexicographic order, consecutive points of a jittered scan lie far apart in phi, and
+ * every walk crosses the window.) The conflicts found do not depend on the order. */
+std::vector<std::pair<std::uint64_t, pcl::index_t>>
+locationOrder(const std::vector<QuantizedPoint>& q)
+{
+  std::vector<std::pair<std::uint64_t, pcl::index_t>> order(q.size());
+  if (q.empty())
+    return order;
+  std::int64_t lo0 = q[0][0], lo1 = q[0][1];
+  for (const auto& p : q) {
+    lo0 = std::min<std::int64_t>(lo0, p[0]);
+    lo1 = std::min<std::int64_t>(lo1, p[1]);
+  }
+  std::uint64_t highest = 0;
+  for (std::size_t k = 0; k < q.size(); ++k) {
+    // |coordinate| <= 2^26, so each offset fits in 27 bits.
+    const std::uint64_t code =
+        spreadBits(static_cast<std::uint64_t>(q[k][0] - lo0)) |
+        (spreadBits(static_cast<std::uint64_t>(q[k][1] - lo1)) << 1);
+    order[k] = {code, static_cast<pcl::index_t>(k)};
+    highest = std::max(highest, code);
+  }
+  detail::radixSortByKey(order, detail::bitWidth(highest));
+  return order;
+}
+
+/** Merges two sorted sequences of distinct items into new ids, in chunks of the first
+ * one on \a threads threads: item i of A (0 <= i < n) gets id i - skipped_before(i) + (the
+ * number of B items before it), unless skip(i); item j of B (0 <= j < m) gets id j +
+ * (the number of kept A items before it). \a b_before(i) is the number of B items
+ * before A item i (skipped or not); the ids are those of the serial merge. */
+template <typename Skip, typename SkippedBefore, typename BBefore, typename ALess,
+          typename EmitA, typename EmitB>
+void
+mergeInChunks(std::size_t n,
+              std::size_t m,
+              const Skip& skip,
+              const SkippedBefore& skipped_before,
+              const BBefore& b_before,
+              const ALess& a_less, // (i, j): A item i before B item j
+              const EmitA& emit_a,
+              const EmitB& emit_b,
+              unsigned int threads)
+{
+  const std::size_t chunks =
+      threads > 1 && n >= detail::kMinParallelItems ? 4 * std::size_t{threads} : 1;
+  const std::size_t chunk_size = (n + chunks - 1) / chunks;
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(static_cast<int>(threads)) schedule(dynamic, 1) \
+    if (chunks > 1)
+#endif
+  for (std::ptrdiff_t c = 0; c < static_cast<std::ptrdiff_t>(chunks); ++c) {
+    const std::size_t i0 = std::min(n, static_cast<std::size_t>(c) * chunk_size);
+    const std::size_t i1 = std::min(n, i0 + chunk_size);
+    std::size_t j = c == 0 ? 0 : b_before(i0);
+    const std::size_t j1 = i1 == n ? m : b_before(i1);
+    auto id = static_cast<pcl::index_t>(i0 - skipped_before(i0) + j);
+    for (std::size_t i = i0; i < i1; ++i) {
+      if (skip(i))
+        continue;
+      while (j < j1 && !a_less(i, j))
+        emit_b(j++, id++);
+      emit_a(i, id++);
+    }
+    while (j < j1)
+      emit_b(j++, id++);
+  }
+}
+
 int
 localIndex(const Triangle& t, pcl::index_t v)
 {
@@ -53,8 +142,9 @@ class Inserter {
 public:
   Inserter(const std::vector<QuantizedPoint>& points,
            const std::vector<Triangle>& triangles,
-           const std::vector<Triangle>& neighbours)
-  : p_(points), t_(triangles), n_(neighbours)
+           const std::vector<Triangle>& neighbours,
+           unsigned int threads)
+  : p_(points), t_(triangles), n_(neighbours), threads_(std::max(1u, threads))
   {}
 
   bool run(const std::vector<QuantizedPoint>& q,
@@ -91,6 +181,7 @@ private:
   const std::vector<QuantizedPoint>& p_;
   const std::vector<Triangle>& t_;
   const std::vector<Triangle>& n_;
+  const unsigned int threads_;
   std::vector<std::uint8_t> replaced_;  // per old triangle
   std::vector<std::uint32_t> visited_;  // per old triangle: stamp of the last new point
   std::vector<pcl::index_t> conflicts_; // replaced triangles
@@ -186,8 +277,10 @@ Inserter::run(const std::vector<QuantizedPoint>& q,
   // 1. Locate the new points (sorted: consecutive walks are short) and collect the
   // replaced triangles and the hull edges the new points see.
   pcl::index_t hint = 0;
-  for (std::size_t k = 0; k < q.size(); ++k) {
-    const auto stamp = static_cast<std::uint32_t>(k + 1);
+  const auto order = locationOrder(q);
+  for (std::size_t rank = 0; rank < order.size(); ++rank) {
+    const auto k = static_cast<std::size_t>(order[rank].second);
+    const auto stamp = static_cast<std::uint32_t>(rank + 1);
     HullEdge exit;
     if (locate(q[k], hint, exit)) {
       collectConflicts(hint, q[k], stamp);
@@ -218,19 +311,26 @@ Inserter::run(const std::vector<QuantizedPoint>& q,
   // 2. The new numbering: the union in lexicographic order.
   info.old_to_new_point.resize(p_.size());
   info.inserted_points.resize(q.size());
-  out_points.clear();
-  out_points.reserve(p_.size() + q.size());
-  for (std::size_t i = 0, j = 0; i < p_.size() || j < q.size();) {
-    const auto id = static_cast<pcl::index_t>(out_points.size());
-    if (j == q.size() || (i < p_.size() && p_[i] < q[j])) {
-      info.old_to_new_point[i] = id;
-      out_points.push_back(p_[i++]);
-    }
-    else {
-      info.inserted_points[j] = id;
-      out_points.push_back(q[j++]);
-    }
-  }
+  out_points.resize(p_.size() + q.size());
+  mergeInChunks(
+      p_.size(),
+      q.size(),
+      [](std::size_t) { return false; },
+      [](std::size_t) { return std::size_t{0}; },
+      [&](std::size_t i) {
+        return static_cast<std::size_t>(std::lower_bound(q.begin(), q.end(), p_[i]) -
+                                        q.begin());
+      },
+      [&](std::size_t i, std::size_t j) { return p_[i] < q[j]; },
+      [&](std::size_t i, pcl::index_t id) {
+        info.old_to_new_point[i] = id;
+        out_points[id] = p_[i];
+      },
+      [&](std::size_t j, pcl::index_t id) {
+        info.inserted_points[j] = id;
+        out_points[id] = q[j];
+      },
+      threads_);
   const auto& remap = info.old_to_new_point;
 
   // 3. The boundary of the kept triangles around the region: edges between a kept and
@@ -328,40 +428,44 @@ Inserter::run(const std::vector<QuantizedPoint>& q,
     }
   const std::size_t num_kept = num_old - conflicts_.size();
   const std::size_t total = num_kept + fresh.size();
-  out_triangles.clear();
-  out_triangles.reserve(total);
-  info.old_to_new_triangle.assign(num_old, -1);
-  info.new_triangles.clear();
+  out_triangles.resize(total);
+  info.old_to_new_triangle.resize(num_old);
+  info.new_triangles.resize(fresh.size());
   std::vector<pcl::index_t> local_to_new(local_tris.size(), -1);
-  {
-    std::size_t i = 0, j = 0;
-    Triangle kept_tri{};
-    const auto keptAt = [&](std::size_t k) {
-      const Triangle& o = t_[k];
-      return Triangle{remap[o[0]], remap[o[1]], remap[o[2]]};
-    };
-    while (i < num_old && replaced_[i])
-      ++i;
-    if (i < num_old)
-      kept_tri = keptAt(i);
-    while (i < num_old || j < fresh.size()) {
-      const auto id = static_cast<pcl::index_t>(out_triangles.size());
-      if (j == fresh.size() || (i < num_old && kept_tri < fresh[j])) {
-        info.old_to_new_triangle[i] = id;
-        out_triangles.push_back(kept_tri);
-        ++i;
-        while (i < num_old && replaced_[i])
-          ++i;
-        if (i < num_old)
-          kept_tri = keptAt(i);
-      }
-      else {
+  std::sort(conflicts_.begin(), conflicts_.end());
+  const auto keptAt = [&](std::size_t k) {
+    const Triangle& o = t_[k];
+    return Triangle{remap[o[0]], remap[o[1]], remap[o[2]]};
+  };
+  mergeInChunks(
+      num_old,
+      fresh.size(),
+      [&](std::size_t k) { return replaced_[k] != 0; },
+      [&](std::size_t k) {
+        return static_cast<std::size_t>(
+            std::lower_bound(conflicts_.begin(), conflicts_.end(),
+                             static_cast<pcl::index_t>(k)) -
+            conflicts_.begin());
+      },
+      // The renumbering keeps the order of the points, so the old triangles, replaced
+      // or not, stay in canonical order.
+      [&](std::size_t k) {
+        return static_cast<std::size_t>(
+            std::lower_bound(fresh.begin(), fresh.end(), keptAt(k)) - fresh.begin());
+      },
+      [&](std::size_t k, std::size_t j) { return keptAt(k) < fresh[j]; },
+      [&](std::size_t k, pcl::index_t id) {
+        info.old_to_new_triangle[k] = id;
+        out_triangles[id] = keptAt(k);
+      },
+      [&](std::size_t j, pcl::index_t id) {
         local_to_new[fresh_local[j]] = id;
-        info.new_triangles.push_back(id);
-        out_triangles.push_back(fresh[j++]);
-      }
-    }
-  }
+        info.new_triangles[j] = id;
+        out_triangles[id] = fresh[j];
+      },
+      threads_);
+  for (const pcl::index_t t : conflicts_)
+    info.old_to_new_triangle[t] = -1;
 
   // 6. Adjacency: kept pairs renumbered; across the boundary through the edge keys.
   std::unordered_map<std::uint64_t, pcl::index_t> fresh_edges; // region side
@@ -391,7 +495,12 @@ Inserter::run(const std::vector<QuantizedPoint>& q,
   }
   out_neighbours.assign(total, Triangle{-1, -1, -1});
   std::size_t hull_edges = 0;
-  for (std::size_t k = 0; k < num_old; ++k) {
+  const auto n_old = static_cast<std::ptrdiff_t>(num_old);
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(static_cast<int>(threads_)) schedule(static) \
+    if (num_old >= detail::kMinParallelItems) reduction(+ : hull_edges)
+#endif
+  for (std::ptrdiff_t k = 0; k < n_old; ++k) {
     const pcl::index_t id = info.old_to_new_triangle[k];
     if (id < 0)
       continue;
@@ -448,7 +557,8 @@ insertDelaunayPoints(std::vector<QuantizedPoint>& points,
                      std::vector<Triangle>& neighbours,
                      std::vector<QuantizedPoint> new_points,
                      DelaunayInsertion& info,
-                     std::string* error)
+                     std::string* error,
+                     unsigned int num_threads)
 {
   info = DelaunayInsertion();
   const auto inRange = [](const QuantizedPoint& p) {
@@ -487,7 +597,7 @@ insertDelaunayPoints(std::vector<QuantizedPoint>& points,
   }
   std::vector<QuantizedPoint> out_points;
   std::vector<Triangle> out_triangles, out_neighbours;
-  Inserter inserter(points, triangles, neighbours);
+  Inserter inserter(points, triangles, neighbours, num_threads);
   if (!inserter.run(new_points, out_points, out_triangles, out_neighbours, info, error)) {
     info = DelaunayInsertion();
     return false;

@@ -54,6 +54,8 @@ struct DelaunayInsertion {
  *            kMaxDelaunayCoordinate; any order
  * \param[out] info the renumbering and what changed
  * \param[out] error why it failed (may be null)
+ * \param[in] num_threads threads for the linear passes (the result is the same for any
+ *            number)
  * \return false, inputs unchanged, on a precondition violation (unsorted or repeated
  *         points, out of range), on an old triangulation without triangles, or when
  *         the stitched result fails its consistency checks; the caller then
@@ -64,7 +66,8 @@ PCL_EXPORTS bool insertDelaunayPoints(std::vector<QuantizedPoint>& points,
                                       std::vector<Triangle>& neighbours,
                                       std::vector<QuantizedPoint> new_points,
                                       DelaunayInsertion& info,
-                                      std::string* error = nullptr);
+                                      std::string* error = nullptr,
+                                      unsigned int num_threads = 1);
 
 } // namespace selective_seg
 } // namespace pcl

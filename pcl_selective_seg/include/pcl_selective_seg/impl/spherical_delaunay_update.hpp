@@ -88,7 +88,8 @@ SphericalDelaunay<PointT>::insertPoints(std::size_t first_new_point,
   // The insertion changes its arguments only when it succeeds.
   std::string why;
   if (!insertDelaunayPoints(
-          tri.vertex_angles, tri.triangles, neighbours, new_angles, info, &why)) {
+          tri.vertex_angles, tri.triangles, neighbours, new_angles, info, &why,
+          num_threads_)) {
     PCL_DEBUG("[pcl::selective_seg::%s::insertPoints] %s: triangulating again\n",
               getClassName().c_str(),
               why.c_str());
