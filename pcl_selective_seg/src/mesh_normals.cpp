@@ -164,6 +164,51 @@ computeTriangleNormalsAndEdgeOn(const Vector3fVector& positions,
   }
 }
 
+void
+updateTriangleNormalsAndEdgeOn(const Vector3fVector& positions,
+                               const std::vector<Triangle>& triangles,
+                               const Eigen::Vector3f& viewpoint,
+                               double max_incidence,
+                               const std::vector<pcl::index_t>& old_to_new,
+                               const std::vector<pcl::index_t>& changed,
+                               Vector3fVector& normals,
+                               std::vector<double>& areas,
+                               std::vector<std::uint8_t>& edge_on,
+                               int num_threads)
+{
+  const std::size_t n_new = triangles.size();
+  Vector3fVector new_normals(n_new);
+  std::vector<double> new_areas(n_new);
+  std::vector<std::uint8_t> new_edge_on(n_new);
+  const auto n_old = static_cast<std::ptrdiff_t>(old_to_new.size());
+  const int moving = static_cast<std::size_t>(n_old) >= detail::kMinParallelItems
+                         ? threads(num_threads)
+                         : 1;
+#pragma omp parallel for num_threads(moving) schedule(static)
+  for (std::ptrdiff_t k = 0; k < n_old; ++k) {
+    const pcl::index_t t = old_to_new[k];
+    if (t < 0)
+      continue;
+    new_normals[t] = normals[k];
+    new_areas[t] = areas[k];
+    new_edge_on[t] = edge_on[k];
+  }
+  const double min_cos = minIncidenceCos(max_incidence);
+  const Eigen::Vector3d eye = viewpoint.cast<double>();
+  const auto n_changed = static_cast<std::ptrdiff_t>(changed.size());
+#pragma omp parallel for num_threads(threads(num_threads)) schedule(dynamic, 1024) \
+    if (changed.size() >= detail::kMinParallelItems)
+  for (std::ptrdiff_t k = 0; k < n_changed; ++k) {
+    const pcl::index_t t = changed[k];
+    new_normals[t] = Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN());
+    triangleNormal(positions, triangles[t], eye, new_normals[t], new_areas[t]);
+    new_edge_on[t] = isEdgeOn(positions, triangles[t], new_normals[t], eye, min_cos);
+  }
+  normals.swap(new_normals);
+  areas.swap(new_areas);
+  edge_on.swap(new_edge_on);
+}
+
 namespace {
 
 /** Smallest vertex of a triangle. */
@@ -193,11 +238,18 @@ recomputeOverStars(std::vector<std::pair<pcl::index_t, pcl::index_t>>& seeds,
                    std::vector<double>& vertex_areas,
                    int num_threads)
 {
-  std::sort(seeds.begin(), seeds.end());
-  seeds.erase(std::unique(seeds.begin(),
-                          seeds.end(),
-                          [](const auto& a, const auto& b) { return a.first == b.first; }),
-              seeds.end());
+  // Each vertex once, with the first triangle listed for it: the star and its sum do
+  // not depend on the triangle the walk starts from (starOf() sorts the star).
+  {
+    std::vector<std::uint8_t> listed(vertex_normals.size(), 0);
+    std::size_t kept = 0;
+    for (const auto& seed : seeds)
+      if (!listed[seed.first]) {
+        listed[seed.first] = 1;
+        seeds[kept++] = seed;
+      }
+    seeds.resize(kept);
+  }
   const auto num_seeds = static_cast<std::ptrdiff_t>(seeds.size());
 #pragma omp parallel num_threads(num_threads)
   {

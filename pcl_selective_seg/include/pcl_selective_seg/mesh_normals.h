@@ -133,6 +133,26 @@ PCL_EXPORTS void computeTriangleNormalsAndEdgeOn(const Vector3fVector& positions
                                                  std::vector<std::uint8_t>& edge_on,
                                                  int num_threads = 0);
 
+/** \brief computeTriangleNormalsAndEdgeOn() after a local change of the mesh: the
+ * values of the kept triangles are moved from the old arrays, those of the triangles in
+ * \a changed computed again.
+ *
+ * \param[in] old_to_new #T_old new id of each old triangle, -1 if it is gone
+ * \param[in] changed new ids of the triangles to compute (the new triangles and any
+ *            whose corners moved); every other new triangle must have an old one
+ * \param[in,out] normals,areas,edge_on on input the old arrays (#T_old), on output the
+ *                new ones (#T), as computeTriangleNormalsAndEdgeOn() gives them */
+PCL_EXPORTS void updateTriangleNormalsAndEdgeOn(const Vector3fVector& positions,
+                                                const std::vector<Triangle>& triangles,
+                                                const Eigen::Vector3f& viewpoint,
+                                                double max_incidence,
+                                                const std::vector<pcl::index_t>& old_to_new,
+                                                const std::vector<pcl::index_t>& changed,
+                                                Vector3fVector& normals,
+                                                std::vector<double>& areas,
+                                                std::vector<std::uint8_t>& edge_on,
+                                                int num_threads = 0);
+
 /** \brief Recompute, after a local change of the mesh, the vertex normals and areas
  * (eq. 2-3) of the changed triangles' vertices, from the triangle normals and areas of
  * the whole mesh; the other vertices' values are taken as valid. Gives the values

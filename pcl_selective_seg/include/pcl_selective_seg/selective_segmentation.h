@@ -219,9 +219,13 @@ protected:
    * from scratch (the state is then unchanged), or set \a failed (reported). */
   bool updateMesh(std::size_t first_new_point, bool& failed);
 
-  /** \brief update(): triangle and vertex normals where the mesh changed. */
+  /** \brief update(): triangle and vertex normals where the mesh changed, reusing the
+   * previous result's triangle normals and areas (taken from \a old_normals and
+   * \a old_areas) where it can. */
   void updateNormals(const DelaunayInsertion& info,
-                     const std::vector<pcl::index_t>& moved_vertices);
+                     const std::vector<pcl::index_t>& moved_vertices,
+                     Vector3fVector& old_normals,
+                     std::vector<double>& old_areas);
 
   /** \brief Stage 4: the multi-resolution octree (eq. 4-5). */
   bool buildOctree();

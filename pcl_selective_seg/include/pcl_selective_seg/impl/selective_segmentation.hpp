@@ -404,15 +404,18 @@ SelectiveSegmentation<PointT>::fillMeshAndLeaves(
                     params_.num_threads);
   // The triangles over input points; the triangle normals and areas move into the
   // result (the normals turned to the cloud frame): the run needs them no more, and
-  // they are the largest arrays.
+  // they are the largest arrays. When the frames coincide the normals are moved as
+  // they are, and update() can take them back for the triangles it keeps.
   mesh.triangles.resize(tri.triangles.size());
+  const bool turn = to_cloud != Eigen::Matrix3f::Identity();
 #ifdef _OPENMP
 #pragma omp parallel for num_threads(numThreads()) schedule(static)
 #endif
   for (std::ptrdiff_t t = 0; t < num_triangles; ++t) {
     for (int i = 0; i < 3; ++i)
       mesh.triangles[t][i] = tri.vertex_point[tri.triangles[t][i]];
-    triangle_normals_[t] = to_cloud * triangle_normals_[t];
+    if (turn)
+      triangle_normals_[t] = to_cloud * triangle_normals_[t];
   }
   mesh.normals = std::move(triangle_normals_);
   mesh.areas = std::move(triangle_areas_);

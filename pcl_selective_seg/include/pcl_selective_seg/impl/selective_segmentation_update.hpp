@@ -100,6 +100,11 @@ SelectiveSegmentation<PointT>::updateMesh(std::size_t first_new_point, bool& fai
   }
   std::vector<Triangle> adjacency;
   adjacency.swap(result_.mesh.neighbours);
+  // The old triangle normals and areas, for the triangles the insertion kept.
+  Vector3fVector old_normals;
+  std::vector<double> old_areas;
+  old_normals.swap(result_.mesh.normals);
+  old_areas.swap(result_.mesh.areas);
   update_stats_.incremental = true;
   update_stats_.new_vertices = info.inserted_points.size();
   update_stats_.moved_vertices = moved.size();
@@ -110,7 +115,7 @@ SelectiveSegmentation<PointT>::updateMesh(std::size_t first_new_point, bool& fai
   takeTriangulationCounts();
   result_.timings.delaunay = watch.getTimeSeconds();
   watch.reset();
-  updateNormals(info, moved);
+  updateNormals(info, moved, old_normals, old_areas);
   if (!publishNormals()) {
     failed = true;
     return false;
@@ -123,23 +128,15 @@ SelectiveSegmentation<PointT>::updateMesh(std::size_t first_new_point, bool& fai
 template <typename PointT>
 void
 SelectiveSegmentation<PointT>::updateNormals(const DelaunayInsertion& info,
-                                             const std::vector<pcl::index_t>& moved)
+                                             const std::vector<pcl::index_t>& moved,
+                                             Vector3fVector& old_normals,
+                                             std::vector<double>& old_areas)
 {
   const SphericalTriangulation& tri = delaunay_.getTriangulation();
   const std::vector<Triangle>& adjacency = result_.mesh.neighbours;
   const std::size_t num_triangles = tri.triangles.size();
   const std::size_t num_vertices = tri.vertex_positions.size();
-  // Triangle normals, areas and edge-on flags: one parallel pass over all triangles
-  // (the result keeps the old ones in the cloud frame only). The changed triangles
-  // are the new ones and those at a moved vertex.
-  computeTriangleNormalsAndEdgeOn(tri.vertex_positions,
-                                  tri.triangles,
-                                  Eigen::Vector3f::Zero(),
-                                  params_.max_view_incidence_angle,
-                                  triangle_normals_,
-                                  triangle_areas_,
-                                  triangle_edge_on_,
-                                  params_.num_threads);
+  // The changed triangles: the new ones and those at a moved vertex.
   std::vector<pcl::index_t> changed = info.new_triangles;
   if (!moved.empty()) {
     std::vector<std::uint8_t> is_moved(num_vertices, 0);
@@ -153,6 +150,34 @@ SelectiveSegmentation<PointT>::updateNormals(const DelaunayInsertion& info,
     std::sort(changed.begin(), changed.end());
     changed.erase(std::unique(changed.begin(), changed.end()), changed.end());
   }
+  // Triangle normals, areas and edge-on flags: the kept triangles' from the result
+  // when it holds them as computed (the sensor frame is the cloud frame: see
+  // fillMeshAndLeaves()), the changed ones computed again.
+  const std::size_t num_old = info.old_to_new_triangle.size();
+  if (sensorToCloud() == Eigen::Matrix3f::Identity() && old_normals.size() == num_old &&
+      old_areas.size() == num_old && triangle_edge_on_.size() == num_old) {
+    triangle_normals_.swap(old_normals);
+    triangle_areas_.swap(old_areas);
+    updateTriangleNormalsAndEdgeOn(tri.vertex_positions,
+                                   tri.triangles,
+                                   Eigen::Vector3f::Zero(),
+                                   params_.max_view_incidence_angle,
+                                   info.old_to_new_triangle,
+                                   changed,
+                                   triangle_normals_,
+                                   triangle_areas_,
+                                   triangle_edge_on_,
+                                   params_.num_threads);
+  }
+  else
+    computeTriangleNormalsAndEdgeOn(tri.vertex_positions,
+                                    tri.triangles,
+                                    Eigen::Vector3f::Zero(),
+                                    params_.max_view_incidence_angle,
+                                    triangle_normals_,
+                                    triangle_areas_,
+                                    triangle_edge_on_,
+                                    params_.num_threads);
   // Vertex normals: the old ones renumbered, recomputed at the changed triangles.
   Vector3fVector vertex_normals(num_vertices);
   auto vertex_areas = std::make_shared<std::vector<double>>(num_vertices, 0.0);
