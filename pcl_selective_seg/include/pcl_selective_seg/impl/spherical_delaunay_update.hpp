@@ -37,21 +37,32 @@ SphericalDelaunay<PointT>::insertPoints(std::size_t first_new_point,
   const auto n = static_cast<pcl::index_t>(cloud.size());
   const Eigen::Affine3d pose = getSensorPose().template cast<double>();
 
-  // The new points' angles.
-  std::vector<std::pair<std::uint64_t, pcl::index_t>> keyed;
-  std::vector<std::pair<pcl::index_t, pcl::index_t>> excluded; // (point, status)
+  // The new points' angles, computed in parallel.
+  std::vector<pcl::index_t> fresh_points;
   for (const pcl::index_t i : indices) {
     if (i < 0 || i >= n) {
       this->deinitCompute();
       return false;
     }
-    if (static_cast<std::size_t>(i) < first_new_point)
-      continue;
-    const auto entry = projectPoint(pose, i);
-    if (entry.first == detail::kExcludedKey)
-      excluded.emplace_back(i, entry.second);
+    if (static_cast<std::size_t>(i) >= first_new_point)
+      fresh_points.push_back(i);
+  }
+  std::vector<std::pair<std::uint64_t, pcl::index_t>> projected(fresh_points.size());
+  const auto num_fresh = static_cast<std::ptrdiff_t>(fresh_points.size());
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(num_threads_) schedule(dynamic, 1024) \
+    if (fresh_points.size() >= detail::kMinParallelItems)
+#endif
+  for (std::ptrdiff_t k = 0; k < num_fresh; ++k)
+    projected[k] = projectPoint(pose, fresh_points[k]);
+  std::vector<std::pair<std::uint64_t, pcl::index_t>> keyed;
+  std::vector<std::pair<pcl::index_t, pcl::index_t>> excluded; // (point, status)
+  keyed.reserve(projected.size());
+  for (std::size_t k = 0; k < projected.size(); ++k) {
+    if (projected[k].first == detail::kExcludedKey)
+      excluded.emplace_back(fresh_points[k], projected[k].second);
     else
-      keyed.push_back(entry);
+      keyed.push_back(projected[k]);
   }
   std::sort(keyed.begin(), keyed.end());
 
@@ -101,7 +112,12 @@ SphericalDelaunay<PointT>::insertPoints(std::size_t first_new_point,
   const std::size_t num_vertices = tri.vertex_angles.size();
   pcl::Indices vertex_point(num_vertices);
   std::vector<Eigen::Vector3f> positions(num_vertices);
-  for (std::size_t v = 0; v < tri.vertex_point.size(); ++v) {
+  const auto num_old = static_cast<std::ptrdiff_t>(tri.vertex_point.size());
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(num_threads_) schedule(static) \
+    if (tri.vertex_point.size() >= detail::kMinParallelItems)
+#endif
+  for (std::ptrdiff_t v = 0; v < num_old; ++v) {
     vertex_point[info.old_to_new_point[v]] = tri.vertex_point[v];
     positions[info.old_to_new_point[v]] = tri.vertex_positions[v];
   }
@@ -119,7 +135,12 @@ SphericalDelaunay<PointT>::insertPoints(std::size_t first_new_point,
       moved_vertices.push_back(v);
     }
   std::vector<pcl::index_t> point_vertex(cloud.size(), kOutsideIndices);
-  for (std::size_t i = 0; i < first_new_point; ++i) {
+  const auto num_old_points = static_cast<std::ptrdiff_t>(first_new_point);
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(num_threads_) schedule(static) \
+    if (first_new_point >= detail::kMinParallelItems)
+#endif
+  for (std::ptrdiff_t i = 0; i < num_old_points; ++i) {
     const pcl::index_t v = tri.point_vertex[i];
     point_vertex[i] = v >= 0 ? info.old_to_new_point[v] : v;
   }
