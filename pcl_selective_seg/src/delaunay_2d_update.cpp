@@ -274,8 +274,8 @@ Inserter::run(const std::vector<QuantizedPoint>& q,
   visited_.assign(num_old, 0);
   std::vector<pcl::index_t> chain; // old hull vertices seen from new points
 
-  // 1. Locate the new points (sorted: consecutive walks are short) and collect the
-  // replaced triangles and the hull edges the new points see.
+  // 1. Locate the new points (along a Z-order curve: consecutive walks are short) and
+  // collect the replaced triangles and the hull edges the new points see.
   pcl::index_t hint = 0;
   const auto order = locationOrder(q);
   for (std::size_t rank = 0; rank < order.size(); ++rank) {
