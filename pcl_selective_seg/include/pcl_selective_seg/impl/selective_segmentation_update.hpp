@@ -181,7 +181,12 @@ SelectiveSegmentation<PointT>::updateNormals(const DelaunayInsertion& info,
   // Vertex normals: the old ones renumbered, recomputed at the changed triangles.
   Vector3fVector vertex_normals(num_vertices);
   auto vertex_areas = std::make_shared<std::vector<double>>(num_vertices, 0.0);
-  for (std::size_t v = 0; v < info.old_to_new_point.size(); ++v) {
+  const auto num_old_vertices = static_cast<std::ptrdiff_t>(info.old_to_new_point.size());
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(numThreads()) schedule(static) \
+    if (info.old_to_new_point.size() >= detail::kMinParallelItems)
+#endif
+  for (std::ptrdiff_t v = 0; v < num_old_vertices; ++v) {
     vertex_normals[info.old_to_new_point[v]] = vertex_normals_[v];
     (*vertex_areas)[info.old_to_new_point[v]] = (*vertex_areas_)[v];
   }
