@@ -27,10 +27,6 @@
 #include <cstdint>
 #include <unordered_map>
 
-#ifdef _OPENMP
-#include <omp.h>
-#endif
-
 namespace pcl {
 namespace selective_seg {
 

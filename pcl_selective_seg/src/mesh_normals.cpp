@@ -91,6 +91,22 @@ isEdgeOn(const Vector3fVector& positions,
   return std::abs(sight.dot(normal.cast<double>())) < min_cos;
 }
 
+/** Normal, area and edge-on flag of one triangle, as computeTriangleNormalsAndEdgeOn()
+ * gives them (the normal NaN for a degenerate triangle). */
+inline void
+triangleNormalAndEdgeOn(const Vector3fVector& positions,
+                        const Triangle& triangle,
+                        const Eigen::Vector3d& eye,
+                        double min_cos,
+                        Eigen::Vector3f& normal,
+                        double& area,
+                        std::uint8_t& edge_on)
+{
+  normal = Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN());
+  triangleNormal(positions, triangle, eye, normal, area);
+  edge_on = isEdgeOn(positions, triangle, normal, eye, min_cos);
+}
+
 /** eq. 2-3 at one vertex over its triangles [begin, end), in that order. */
 void
 vertexNormal(const pcl::index_t* begin,
@@ -150,18 +166,17 @@ computeTriangleNormalsAndEdgeOn(const Vector3fVector& positions,
                                 std::vector<std::uint8_t>& edge_on,
                                 int num_threads)
 {
-  const float nan = std::numeric_limits<float>::quiet_NaN();
-  normals.assign(triangles.size(), Eigen::Vector3f::Constant(nan));
-  areas.assign(triangles.size(), 0.0);
-  edge_on.assign(triangles.size(), 0);
+  // Every entry is written below.
+  normals.resize(triangles.size());
+  areas.resize(triangles.size());
+  edge_on.resize(triangles.size());
   const double min_cos = minIncidenceCos(max_incidence);
   const Eigen::Vector3d eye = viewpoint.cast<double>();
   const auto n_tri = static_cast<std::ptrdiff_t>(triangles.size());
 #pragma omp parallel for num_threads(threads(num_threads)) schedule(dynamic, 1024)
-  for (std::ptrdiff_t t = 0; t < n_tri; ++t) {
-    triangleNormal(positions, triangles[t], eye, normals[t], areas[t]);
-    edge_on[t] = isEdgeOn(positions, triangles[t], normals[t], eye, min_cos);
-  }
+  for (std::ptrdiff_t t = 0; t < n_tri; ++t)
+    triangleNormalAndEdgeOn(
+        positions, triangles[t], eye, min_cos, normals[t], areas[t], edge_on[t]);
 }
 
 void
@@ -200,9 +215,13 @@ updateTriangleNormalsAndEdgeOn(const Vector3fVector& positions,
     if (changed.size() >= detail::kMinParallelItems)
   for (std::ptrdiff_t k = 0; k < n_changed; ++k) {
     const pcl::index_t t = changed[k];
-    new_normals[t] = Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN());
-    triangleNormal(positions, triangles[t], eye, new_normals[t], new_areas[t]);
-    new_edge_on[t] = isEdgeOn(positions, triangles[t], new_normals[t], eye, min_cos);
+    triangleNormalAndEdgeOn(positions,
+                            triangles[t],
+                            eye,
+                            min_cos,
+                            new_normals[t],
+                            new_areas[t],
+                            new_edge_on[t]);
   }
   normals.swap(new_normals);
   areas.swap(new_areas);

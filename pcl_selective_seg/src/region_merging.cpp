@@ -9,10 +9,6 @@
 
 #include "incidence_build.h"
 
-#ifdef _OPENMP
-#include <omp.h>
-#endif
-
 #include <algorithm>
 #include <array>
 #include <cmath>
