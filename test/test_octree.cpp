@@ -723,6 +723,83 @@ TEST(OctreePointCloudNormalVariance, SensorOrientation)
             0.01f);
 }
 
+/** Every field of two trees' leaves and orderings, bit for bit. */
+void
+expectSameLeaves(const Octree& a, const Octree& b)
+{
+  EXPECT_EQ(a.getOrderedIndices(), b.getOrderedIndices());
+  ASSERT_EQ(a.getAdaptiveLeaves().size(), b.getAdaptiveLeaves().size());
+  for (std::size_t l = 0; l < a.getAdaptiveLeaves().size(); ++l) {
+    SCOPED_TRACE(l);
+    const AdaptiveLeaf& x = a.getAdaptiveLeaves()[l];
+    const AdaptiveLeaf& y = b.getAdaptiveLeaves()[l];
+    EXPECT_EQ(x.key, y.key);
+    EXPECT_EQ(x.depth, y.depth);
+    EXPECT_EQ(x.begin, y.begin);
+    EXPECT_EQ(x.end, y.end);
+    EXPECT_EQ(x.area, y.area);
+    EXPECT_EQ(x.sigma_theta, y.sigma_theta);
+    EXPECT_EQ(x.sigma_phi, y.sigma_phi);
+    EXPECT_EQ(x.normal, y.normal);
+  }
+}
+
+// addPointsAndComputeAdaptiveLeaves() computes the normal angles while it builds the
+// tree: the tree and leaves must be those of the two separate calls for any thread
+// count and sensor orientation, and a later computeAdaptiveLeaves() must start afresh.
+TEST(OctreePointCloudNormalVariance, OneCallGivesTheSameLeaves)
+{
+  // A bumpy sheet with noisy normals, a few invalid points, and a turned sensor.
+  Scene scene;
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(-1.f, 1.f);
+  for (int i = 0; i < 20000; ++i) {
+    const float x = u(rng), y = u(rng);
+    const float z = 3.f + 0.2f * std::sin(4.f * x) * std::cos(3.f * y);
+    const Eigen::Vector3f n =
+        Eigen::Vector3f(0.8f * std::cos(4.f * x) * std::cos(3.f * y) + 0.1f * u(rng),
+                        -0.6f * std::sin(4.f * x) * std::sin(3.f * y) + 0.1f * u(rng),
+                        -1.f)
+            .normalized();
+    scene.add(Eigen::Vector3f(x, y, z), n, 1e-4 * (1.5 + u(rng)));
+  }
+  (*scene.normals)[17].normal_x = std::numeric_limits<float>::quiet_NaN();
+  (*scene.areas)[99] = 0.0;
+  const Eigen::Quaternionf q(
+      Eigen::AngleAxisf(0.3f, Eigen::Vector3f(0.2f, 1.f, 0.1f).normalized()));
+  for (const Eigen::Quaternionf* orientation :
+       {static_cast<const Eigen::Quaternionf*>(nullptr), &q}) {
+    const auto two_calls = buildOctree(
+        scene, 0.01, kPaperThreshold, kMinPoints, nullptr, orientation, 1);
+    ASSERT_GT(two_calls->getAdaptiveLeaves().size(), 100u);
+    for (unsigned int threads : {1u, 2u, 3u}) {
+      SCOPED_TRACE(threads);
+      Octree one_call(0.01);
+      one_call.setNumberOfThreads(threads);
+      one_call.setInputCloud(scene.cloud);
+      one_call.setInputNormals(scene.normals, scene.areas);
+      if (orientation)
+        one_call.setSensorOrientation(*orientation);
+      ASSERT_TRUE(one_call.addPointsAndComputeAdaptiveLeaves(kPaperThreshold, kMinPoints));
+      expectSameLeaves(one_call, *two_calls);
+      expectPartition(one_call, validPoints(scene));
+      // Again with another threshold: the angles are computed again.
+      one_call.computeAdaptiveLeaves(2.0 * kPaperThreshold, kMinPoints);
+      const auto coarser = buildOctree(
+          scene, 0.01, 2.0 * kPaperThreshold, kMinPoints, nullptr, orientation, 1);
+      expectSameLeaves(one_call, *coarser);
+    }
+  }
+  // Nothing to insert: false, no leaves.
+  Scene invalid;
+  invalid.add(Eigen::Vector3f(0.f, 0.f, 1.f), Eigen::Vector3f(0.f, 0.f, -1.f), 0.0);
+  Octree none(0.1);
+  none.setInputCloud(invalid.cloud);
+  none.setInputNormals(invalid.normals, invalid.areas);
+  EXPECT_FALSE(none.addPointsAndComputeAdaptiveLeaves(kPaperThreshold, kMinPoints));
+  EXPECT_TRUE(none.getAdaptiveLeaves().empty());
+}
+
 int
 main(int argc, char** argv)
 {

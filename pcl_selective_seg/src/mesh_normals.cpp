@@ -92,7 +92,9 @@ isEdgeOn(const Vector3fVector& positions,
 }
 
 /** Normal, area and edge-on flag of one triangle, as computeTriangleNormalsAndEdgeOn()
- * gives them (the normal NaN for a degenerate triangle). */
+ * gives them (the normal NaN for a degenerate triangle): triangleNormal() and
+ * isEdgeOn() in one pass, the corners read and the centroid computed once (the same
+ * expressions, so the same values). */
 inline void
 triangleNormalAndEdgeOn(const Vector3fVector& positions,
                         const Triangle& triangle,
@@ -102,9 +104,28 @@ triangleNormalAndEdgeOn(const Vector3fVector& positions,
                         double& area,
                         std::uint8_t& edge_on)
 {
-  normal = Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN());
-  triangleNormal(positions, triangle, eye, normal, area);
-  edge_on = isEdgeOn(positions, triangle, normal, eye, min_cos);
+  const Eigen::Vector3d a = positions[triangle[0]].cast<double>();
+  const Eigen::Vector3d b = positions[triangle[1]].cast<double>();
+  const Eigen::Vector3d c = positions[triangle[2]].cast<double>();
+  Eigen::Vector3d n = (b - a).cross(c - a);
+  const double twice_area = n.norm();
+  area = 0.5 * twice_area;
+  if (!(twice_area > 0.0) || !std::isfinite(twice_area)) {
+    normal = Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN());
+    edge_on = 1;
+    return;
+  }
+  n /= twice_area;
+  const Eigen::Vector3d centroid = (a + b + c) / 3.0;
+  if (n.dot(centroid - eye) > 0.0)
+    n = -n;
+  normal = n.cast<float>();
+  if (!normal.allFinite()) {
+    edge_on = 1;
+    return;
+  }
+  const Eigen::Vector3d sight = (centroid - eye).normalized();
+  edge_on = std::abs(sight.dot(normal.cast<double>())) < min_cos;
 }
 
 /** eq. 2-3 at one vertex over its triangles [begin, end), in that order. */

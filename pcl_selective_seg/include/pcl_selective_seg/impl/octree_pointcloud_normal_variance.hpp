@@ -96,6 +96,25 @@ template <typename PointT>
 bool
 OctreePointCloudNormalVariance<PointT>::addPointsFromInputCloud()
 {
+  return insertPoints(false);
+}
+
+template <typename PointT>
+bool
+OctreePointCloudNormalVariance<PointT>::addPointsAndComputeAdaptiveLeaves(
+    double max_std_dev, std::size_t min_points_to_split)
+{
+  if (!insertPoints(true))
+    return false;
+  computeAdaptiveLeaves(max_std_dev, min_points_to_split);
+  return true;
+}
+
+template <typename PointT>
+bool
+OctreePointCloudNormalVariance<PointT>::insertPoints(bool with_angles)
+{
+  angles_ready_ = false;
   if (!this->input_ || (!normals_ && !normal_vectors_) || !areas_)
     return false;
   // Which points are valid, and their box, in parallel (a flag per candidate, then one
@@ -180,43 +199,77 @@ OctreePointCloudNormalVariance<PointT>::addPointsFromInputCloud()
     return true;
   }
   detail::radixSortByKey(order, static_cast<int>(3 * depth), num_threads_);
-  // The leaves' indices, in one array that each leaf container views.
-  voxel_indices_.resize(order.size());
-#ifdef _OPENMP
-#pragma omp parallel for num_threads(num_threads_) schedule(static)
-#endif
-  for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(order.size()); ++k)
-    voxel_indices_[k] = order[k].second;
-  // The same tree as PCL's point-by-point insertion (addPointIdx()), built along the
-  // sorted codes: consecutive voxels share the branches of their common prefix, so
-  // each node is created once, from its parent, and each leaf's indices are stored
-  // with one allocation.
-  std::vector<BranchNode*> path(depth, nullptr);
-  path[0] = this->root_node_;
-  for (std::size_t begin = 0; begin < order.size();) {
-    const std::uint64_t code = order[begin].first;
-    std::size_t end = begin + 1;
-    while (end < order.size() && order[end].first == code)
-      ++end;
-    // The first level whose child differs from the previous voxel's.
-    unsigned level = 0;
-    if (begin > 0) {
-      const std::uint64_t differ = code ^ order[begin - 1].first;
-      level = depth - 1 - static_cast<unsigned>(detail::bitWidth(differ) - 1) / 3;
-    }
-    const auto child = [&](unsigned d) {
-      return static_cast<unsigned char>((code >> (3 * (depth - 1 - d))) & 7u);
-    };
-    for (unsigned d = level; d + 1 < depth; ++d) {
-      path[d + 1] = this->createBranchChild(*path[d], child(d));
-      ++this->branch_count_;
-    }
-    LeafNode* leaf = this->createLeafChild(*path[depth - 1], child(depth - 1));
-    ++this->leaf_count_;
-    leaf->getContainer().viewPointIndices(voxel_indices_.data() + begin,
-                                          static_cast<pcl::uindex_t>(end - begin));
-    begin = end;
+  // The leaves' indices, in one array that each leaf container views. The sorted codes
+  // are the depth-first order of the tree (PCL numbers a node's children by the same
+  // bits), so with_angles gives the ordered points and their normal angles right away:
+  // one thread builds the tree while the others start on the angles, and joins them
+  // when it is done (computeNormalAngles() gives the same values).
+  const std::size_t n = order.size();
+  voxel_indices_.resize(n);
+  if (with_angles) {
+    ordered_indices_.resize(n);
+    resizeScratch(n);
   }
+  const Eigen::Matrix3d to_sensor =
+      sensor_orientation_.toRotationMatrix().transpose().template cast<double>();
+  const auto build_tree = [&] {
+    // The same tree as PCL's point-by-point insertion (addPointIdx()), built along the
+    // sorted codes: consecutive voxels share the branches of their common prefix, so
+    // each node is created once, from its parent.
+    std::vector<BranchNode*> path(depth, nullptr);
+    path[0] = this->root_node_;
+    for (std::size_t begin = 0; begin < n;) {
+      const std::uint64_t code = order[begin].first;
+      std::size_t end = begin + 1;
+      while (end < n && order[end].first == code)
+        ++end;
+      // The first level whose child differs from the previous voxel's.
+      unsigned level = 0;
+      if (begin > 0) {
+        const std::uint64_t differ = code ^ order[begin - 1].first;
+        level = depth - 1 - static_cast<unsigned>(detail::bitWidth(differ) - 1) / 3;
+      }
+      const auto child = [&](unsigned d) {
+        return static_cast<unsigned char>((code >> (3 * (depth - 1 - d))) & 7u);
+      };
+      for (unsigned d = level; d + 1 < depth; ++d) {
+        path[d + 1] = this->createBranchChild(*path[d], child(d));
+        ++this->branch_count_;
+      }
+      LeafNode* leaf = this->createLeafChild(*path[depth - 1], child(depth - 1));
+      ++this->leaf_count_;
+      auto& container = leaf->getContainer();
+      // A view only: the entries are written by the loop below, maybe meanwhile.
+      container.viewPointIndices(voxel_indices_.data() + begin,
+                                 static_cast<pcl::uindex_t>(end - begin));
+      container.setFirstOrderedPoint(begin);
+      begin = end;
+    }
+  };
+#ifdef _OPENMP
+#pragma omp parallel num_threads(num_threads_)
+#endif
+  {
+    if (with_angles) {
+#ifdef _OPENMP
+#pragma omp single nowait
+#endif
+      build_tree();
+    }
+#ifdef _OPENMP
+#pragma omp for schedule(dynamic, 1024) nowait
+#endif
+    for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(n); ++k) {
+      voxel_indices_[k] = order[k].second;
+      if (with_angles) {
+        ordered_indices_[k] = order[k].second;
+        computeNormalAngle(static_cast<std::size_t>(k), to_sensor, order.data(), n);
+      }
+    }
+  }
+  if (!with_angles)
+    build_tree();
+  angles_ready_ = with_angles;
   return true;
 }
 
@@ -239,35 +292,57 @@ OctreePointCloudNormalVariance<PointT>::orderPoints(const pcl::octree::OctreeNod
 
 template <typename PointT>
 void
-OctreePointCloudNormalVariance<PointT>::computeNormalAngles()
+OctreePointCloudNormalVariance<PointT>::resizeScratch(std::size_t n)
 {
-  const std::size_t n = ordered_indices_.size();
   ordered_normals_.resize(n);
   ordered_theta_.resize(n);
   ordered_phi_.resize(n);
   ordered_weights_.resize(n);
+}
+
+template <typename PointT>
+template <typename Entry>
+void
+OctreePointCloudNormalVariance<PointT>::computeNormalAngle(std::size_t k,
+                                                           const Eigen::Matrix3d& to_sensor,
+                                                           const Entry* entries,
+                                                           std::size_t n)
+{
+  const auto index_of = [](const auto& entry) {
+    if constexpr (std::is_same<std::decay_t<decltype(entry)>, pcl::index_t>::value)
+      return entry;
+    else
+      return entry.second;
+  };
+  // The points are in Morton order, their normals and areas in vertex order: ask for
+  // those of a point a few iterations ahead (a hint; no effect on the values).
+  if (k + 16 < n && normal_vectors_) {
+    const auto ahead = static_cast<std::size_t>(index_of(entries[k + 16]));
+    __builtin_prefetch((*normal_vectors_).data() + ahead);
+    __builtin_prefetch((*areas_).data() + ahead);
+  }
+  const auto i = static_cast<std::size_t>(index_of(entries[k]));
+  const Eigen::Vector3d m =
+      -(to_sensor * inputNormal(i).template cast<double>()).normalized();
+  ordered_normals_[k] = m;
+  ordered_theta_[k] = std::atan2(m.x(), m.z());
+  ordered_phi_[k] = std::atan2(m.y(), m.z());
+  ordered_weights_[k] = 1.0 / (*areas_)[i]; // eq. 4: weight 1 / A_p
+}
+
+template <typename PointT>
+void
+OctreePointCloudNormalVariance<PointT>::computeNormalAngles()
+{
+  const std::size_t n = ordered_indices_.size();
+  resizeScratch(n);
   const Eigen::Matrix3d to_sensor =
       sensor_orientation_.toRotationMatrix().transpose().template cast<double>();
 #ifdef _OPENMP
 #pragma omp parallel for num_threads(num_threads_) schedule(dynamic, 1024)
 #endif
-  for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(n); ++k) {
-    // The points are in Morton order, their normals and areas in vertex order: ask for
-    // those of a point a few iterations ahead (a hint; no effect on the values).
-    if (k + 16 < static_cast<std::ptrdiff_t>(n) && normal_vectors_) {
-      const auto ahead = static_cast<std::size_t>(ordered_indices_[k + 16]);
-      __builtin_prefetch((*normal_vectors_).data() + ahead);
-      __builtin_prefetch((*areas_).data() + ahead);
-    }
-    const auto i = ordered_indices_[k];
-    const Eigen::Vector3d m =
-        -(to_sensor * inputNormal(static_cast<std::size_t>(i)).template cast<double>())
-             .normalized();
-    ordered_normals_[k] = m;
-    ordered_theta_[k] = std::atan2(m.x(), m.z());
-    ordered_phi_[k] = std::atan2(m.y(), m.z());
-    ordered_weights_[k] = 1.0 / (*areas_)[i]; // eq. 4: weight 1 / A_p
-  }
+  for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(n); ++k)
+    computeNormalAngle(static_cast<std::size_t>(k), to_sensor, ordered_indices_.data(), n);
 }
 
 template <typename PointT>
@@ -363,14 +438,22 @@ OctreePointCloudNormalVariance<PointT>::computeAdaptiveLeaves(
     double max_std_dev, std::size_t min_points_to_split)
 {
   leaves_.clear();
-  ordered_indices_.clear();
-  releaseScratch();
-  if (this->leaf_count_ == 0 || !this->root_node_)
+  const bool angles_ready = angles_ready_;
+  angles_ready_ = false;
+  if (!angles_ready) {
+    ordered_indices_.clear();
+    releaseScratch();
+  }
+  if (this->leaf_count_ == 0 || !this->root_node_) {
+    releaseScratch();
     return;
-  ordered_indices_.reserve(this->indices_ ? this->indices_->size()
-                                          : this->input_->size());
-  orderPoints(this->root_node_);
-  computeNormalAngles();
+  }
+  if (!angles_ready) {
+    ordered_indices_.reserve(this->indices_ ? this->indices_->size()
+                                            : this->input_->size());
+    orderPoints(this->root_node_);
+    computeNormalAngles();
+  }
   const std::size_t min_points = std::max<std::size_t>(min_points_to_split, 2);
   const bool finite_weights = std::all_of(ordered_weights_.begin(),
                                           ordered_weights_.end(),

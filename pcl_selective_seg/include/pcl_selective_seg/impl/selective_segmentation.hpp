@@ -278,11 +278,8 @@ SelectiveSegmentation<PointT>::buildOctree()
       std::shared_ptr<const Vector3fVector>(), &vertex_normals_);
   octree_->setInputNormals(lent, vertex_areas_);
   octree_->setNumberOfThreads(static_cast<unsigned int>(params_.num_threads));
-  const bool inserted = octree_->addPointsFromInputCloud();
-  if (inserted)
-    octree_->computeAdaptiveLeaves(
-        params_.max_normal_std_dev,
-        static_cast<std::size_t>(params_.min_points_to_split));
+  const bool inserted = octree_->addPointsAndComputeAdaptiveLeaves(
+      params_.max_normal_std_dev, static_cast<std::size_t>(params_.min_points_to_split));
   octree_->setInputNormals(typename Octree::NormalVectorsConstPtr(), vertex_areas_);
   if (!inserted)
     return fail("extract", "no point with a normal to insert into the octree");
