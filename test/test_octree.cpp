@@ -788,6 +788,13 @@ TEST(OctreePointCloudNormalVariance, OneCallGivesTheSameLeaves)
       const auto coarser = buildOctree(
           scene, 0.01, 2.0 * kPaperThreshold, kMinPoints, nullptr, orientation, 1);
       expectSameLeaves(one_call, *coarser);
+      // The tree built again, by the two calls, on the same octree.
+      one_call.deleteTree();
+      ASSERT_TRUE(one_call.addPointsFromInputCloud());
+      one_call.computeAdaptiveLeaves(kPaperThreshold, kMinPoints);
+      expectSameLeaves(one_call, *two_calls);
+      one_call.computeAdaptiveLeaves(2.0 * kPaperThreshold, kMinPoints);
+      expectSameLeaves(one_call, *coarser);
     }
   }
   // Nothing to insert: false, no leaves.

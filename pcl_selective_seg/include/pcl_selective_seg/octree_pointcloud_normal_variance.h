@@ -167,12 +167,11 @@ protected:
   /** \brief Normals, angles and areas of the ordered points (in parallel). */
   void computeNormalAngles();
 
-  /** \brief The scratch of computeNormalAngles() for the ordered point \a k, whose
-   * index is entries[k] (an index, or a (code, index) pair). */
-  template <typename Entry>
+  /** \brief The scratch of computeNormalAngles() for the ordered point \a k, of index
+   * indices[k] (n points). */
   void computeNormalAngle(std::size_t k,
                           const Eigen::Matrix3d& to_sensor,
-                          const Entry* entries,
+                          const pcl::index_t* indices,
                           std::size_t n);
 
   void resizeScratch(std::size_t n);
@@ -226,12 +225,16 @@ private:
   AreasConstPtr areas_;
   Eigen::Quaternionf sensor_orientation_ = Eigen::Quaternionf::Identity();
   /** The indices of the leaves built by addPointsFromInputCloud(), leaf after leaf;
-   * their containers view them. Assigned only while the tree is empty. */
+   * their containers view them. Assigned only while the tree is empty
+   * (addPointsAndComputeAdaptiveLeaves() stores them in ordered_indices_). */
   pcl::Indices voxel_indices_;
   pcl::Indices ordered_indices_;
   /** ordered_indices_ and the scratch were made by insertPoints(true) for the next
    * computeAdaptiveLeaves(). */
   bool angles_ready_ = false;
+  /** The leaf containers view ordered_indices_ (insertPoints(true)), not voxel_indices_.
+   */
+  bool leaves_view_ordered_ = false;
   detail::ScratchVector<Eigen::Vector3d> ordered_normals_; ///< sensor frame, reversed
   detail::ScratchVector<double> ordered_theta_; ///< angles of ordered_normals_ [rad]
   detail::ScratchVector<double> ordered_phi_;

@@ -184,6 +184,7 @@ OctreePointCloudNormalVariance<PointT>::insertPoints(bool with_angles)
     this->genOctreeKeyforPoint((*this->input_)[valid[k]], key);
     order[k] = {detail::mortonCode(key), valid[k]};
   }
+  pcl::Indices().swap(valid);
   const auto depth = static_cast<unsigned>(this->octree_depth_);
   const bool keys_fit =
       depth <= 21 && std::all_of(order.begin(), order.end(), [&](const auto& entry) {
@@ -199,36 +200,53 @@ OctreePointCloudNormalVariance<PointT>::insertPoints(bool with_angles)
     return true;
   }
   detail::radixSortByKey(order, static_cast<int>(3 * depth), num_threads_);
-  // The leaves' indices, in one array that each leaf container views. The sorted codes
-  // are the depth-first order of the tree (PCL numbers a node's children by the same
-  // bits), so with_angles gives the ordered points and their normal angles right away:
-  // one thread builds the tree while the others start on the angles, and joins them
-  // when it is done (computeNormalAngles() gives the same values).
+  // The leaves' indices, in one array that each leaf container views: with_angles, the
+  // ordered points themselves (the sorted codes are the depth-first order of the tree:
+  // PCL numbers a node's children by the same bits).
   const std::size_t n = order.size();
-  voxel_indices_.resize(n);
-  if (with_angles) {
-    ordered_indices_.resize(n);
-    resizeScratch(n);
-  }
-  const Eigen::Matrix3d to_sensor =
-      sensor_orientation_.toRotationMatrix().transpose().template cast<double>();
+  leaves_view_ordered_ = with_angles; // the tree is empty: no container views either
+  pcl::Indices& leaf_indices = with_angles ? ordered_indices_ : voxel_indices_;
+  leaf_indices.resize(n);
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(num_threads_) schedule(static)
+#endif
+  for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(n); ++k)
+    leaf_indices[k] = order[k].second;
+  // The first entry of each leaf; the points' codes are freed before the scratch of the
+  // angles is allocated (the peak of memory).
+  std::size_t num_voxels = 0;
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(num_threads_) schedule(static) \
+    reduction(+ : num_voxels)
+#endif
+  for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(n); ++k)
+    num_voxels += k == 0 || order[k].first != order[k - 1].first;
+  std::vector<pcl::uindex_t> voxel_begin;
+  voxel_begin.reserve(num_voxels);
+  for (std::size_t k = 0; k < n; ++k)
+    if (k == 0 || order[k].first != order[k - 1].first)
+      voxel_begin.push_back(static_cast<pcl::uindex_t>(k));
+  decltype(order)().swap(order);
+  // The same tree as PCL's point-by-point insertion (addPointIdx()), built along the
+  // sorted codes (computed again for each leaf's first point): consecutive voxels share
+  // the branches of their common prefix, so each node is created once, from its parent.
   const auto build_tree = [&] {
-    // The same tree as PCL's point-by-point insertion (addPointIdx()), built along the
-    // sorted codes: consecutive voxels share the branches of their common prefix, so
-    // each node is created once, from its parent.
     std::vector<BranchNode*> path(depth, nullptr);
     path[0] = this->root_node_;
-    for (std::size_t begin = 0; begin < n;) {
-      const std::uint64_t code = order[begin].first;
-      std::size_t end = begin + 1;
-      while (end < n && order[end].first == code)
-        ++end;
+    std::uint64_t previous = 0;
+    for (std::size_t v = 0; v < num_voxels; ++v) {
+      const std::size_t begin = voxel_begin[v];
+      const std::size_t end = v + 1 < num_voxels ? voxel_begin[v + 1] : n;
+      pcl::octree::OctreeKey key;
+      this->genOctreeKeyforPoint((*this->input_)[leaf_indices[begin]], key);
+      const std::uint64_t code = detail::mortonCode(key);
       // The first level whose child differs from the previous voxel's.
       unsigned level = 0;
-      if (begin > 0) {
-        const std::uint64_t differ = code ^ order[begin - 1].first;
+      if (v > 0) {
+        const std::uint64_t differ = code ^ previous;
         level = depth - 1 - static_cast<unsigned>(detail::bitWidth(differ) - 1) / 3;
       }
+      previous = code;
       const auto child = [&](unsigned d) {
         return static_cast<unsigned char>((code >> (3 * (depth - 1 - d))) & 7u);
       };
@@ -239,37 +257,39 @@ OctreePointCloudNormalVariance<PointT>::insertPoints(bool with_angles)
       LeafNode* leaf = this->createLeafChild(*path[depth - 1], child(depth - 1));
       ++this->leaf_count_;
       auto& container = leaf->getContainer();
-      // A view only: the entries are written by the loop below, maybe meanwhile.
-      container.viewPointIndices(voxel_indices_.data() + begin,
+      container.viewPointIndices(leaf_indices.data() + begin,
                                  static_cast<pcl::uindex_t>(end - begin));
       container.setFirstOrderedPoint(begin);
-      begin = end;
     }
   };
+  if (!with_angles) {
+    build_tree();
+    return true;
+  }
+  // The normal angles of the ordered points (computeNormalAngles() gives the same
+  // values), computed by the other threads while the calling thread builds the tree,
+  // which then joins them.
+  voxel_indices_ = pcl::Indices();
+  resizeScratch(n);
+  const Eigen::Matrix3d to_sensor =
+      sensor_orientation_.toRotationMatrix().transpose().template cast<double>();
 #ifdef _OPENMP
 #pragma omp parallel num_threads(num_threads_)
 #endif
   {
-    if (with_angles) {
+    // On the calling thread: memory a worker thread allocates comes from its own
+    // malloc arena, which would not reuse what the earlier stages freed.
 #ifdef _OPENMP
-#pragma omp single nowait
+#pragma omp master
 #endif
-      build_tree();
-    }
+    build_tree();
 #ifdef _OPENMP
 #pragma omp for schedule(dynamic, 1024) nowait
 #endif
-    for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(n); ++k) {
-      voxel_indices_[k] = order[k].second;
-      if (with_angles) {
-        ordered_indices_[k] = order[k].second;
-        computeNormalAngle(static_cast<std::size_t>(k), to_sensor, order.data(), n);
-      }
-    }
+    for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(n); ++k)
+      computeNormalAngle(static_cast<std::size_t>(k), to_sensor, ordered_indices_.data(), n);
   }
-  if (!with_angles)
-    build_tree();
-  angles_ready_ = with_angles;
+  angles_ready_ = true;
   return true;
 }
 
@@ -301,27 +321,20 @@ OctreePointCloudNormalVariance<PointT>::resizeScratch(std::size_t n)
 }
 
 template <typename PointT>
-template <typename Entry>
 void
 OctreePointCloudNormalVariance<PointT>::computeNormalAngle(std::size_t k,
                                                            const Eigen::Matrix3d& to_sensor,
-                                                           const Entry* entries,
+                                                           const pcl::index_t* indices,
                                                            std::size_t n)
 {
-  const auto index_of = [](const auto& entry) {
-    if constexpr (std::is_same<std::decay_t<decltype(entry)>, pcl::index_t>::value)
-      return entry;
-    else
-      return entry.second;
-  };
   // The points are in Morton order, their normals and areas in vertex order: ask for
   // those of a point a few iterations ahead (a hint; no effect on the values).
   if (k + 16 < n && normal_vectors_) {
-    const auto ahead = static_cast<std::size_t>(index_of(entries[k + 16]));
+    const auto ahead = static_cast<std::size_t>(indices[k + 16]);
     __builtin_prefetch((*normal_vectors_).data() + ahead);
     __builtin_prefetch((*areas_).data() + ahead);
   }
-  const auto i = static_cast<std::size_t>(index_of(entries[k]));
+  const auto i = static_cast<std::size_t>(indices[k]);
   const Eigen::Vector3d m =
       -(to_sensor * inputNormal(i).template cast<double>()).normalized();
   ordered_normals_[k] = m;
@@ -441,7 +454,13 @@ OctreePointCloudNormalVariance<PointT>::computeAdaptiveLeaves(
   const bool angles_ready = angles_ready_;
   angles_ready_ = false;
   if (!angles_ready) {
-    ordered_indices_.clear();
+    // The leaf containers may view ordered_indices_ (insertPoints(true)): that array
+    // moves, its storage unchanged, to voxel_indices_ before the ordering is made again.
+    if (leaves_view_ordered_) {
+      voxel_indices_ = std::move(ordered_indices_);
+      leaves_view_ordered_ = false;
+    }
+    ordered_indices_ = pcl::Indices();
     releaseScratch();
   }
   if (this->leaf_count_ == 0 || !this->root_node_) {
