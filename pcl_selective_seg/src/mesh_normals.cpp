@@ -51,13 +51,14 @@ normalizedOrNaN(const Eigen::Vector3d& sum)
 }
 
 /** Normal (oriented toward the eye) and area of one triangle; the normal stays NaN
- * when the triangle is degenerate. */
-inline void
+ * when the triangle is degenerate (then false; otherwise \a centroid is set). */
+inline bool
 triangleNormal(const Vector3fVector& positions,
                const Triangle& triangle,
                const Eigen::Vector3d& eye,
                Eigen::Vector3f& normal,
-               double& area)
+               double& area,
+               Eigen::Vector3d& centroid)
 {
   const Eigen::Vector3d a = positions[triangle[0]].cast<double>();
   const Eigen::Vector3d b = positions[triangle[1]].cast<double>();
@@ -66,14 +67,40 @@ triangleNormal(const Vector3fVector& positions,
   const double twice_area = n.norm();
   area = 0.5 * twice_area;
   if (!(twice_area > 0.0) || !std::isfinite(twice_area))
-    return;
+    return false;
   n /= twice_area;
-  if (n.dot((a + b + c) / 3.0 - eye) > 0.0)
+  centroid = (a + b + c) / 3.0;
+  if (n.dot(centroid - eye) > 0.0)
     n = -n;
   normal = n.cast<float>();
+  return true;
 }
 
-/** Whether one triangle is seen edge-on (markEdgeOnTriangles()). */
+inline void
+triangleNormal(const Vector3fVector& positions,
+               const Triangle& triangle,
+               const Eigen::Vector3d& eye,
+               Eigen::Vector3f& normal,
+               double& area)
+{
+  Eigen::Vector3d centroid;
+  triangleNormal(positions, triangle, eye, normal, area, centroid);
+}
+
+/** Whether a triangle of this normal and centroid is seen edge-on
+ * (markEdgeOnTriangles()). */
+inline std::uint8_t
+isEdgeOn(const Eigen::Vector3f& normal,
+         const Eigen::Vector3d& centroid,
+         const Eigen::Vector3d& eye,
+         double min_cos)
+{
+  if (!normal.allFinite())
+    return 1;
+  const Eigen::Vector3d sight = (centroid - eye).normalized();
+  return std::abs(sight.dot(normal.cast<double>())) < min_cos;
+}
+
 inline std::uint8_t
 isEdgeOn(const Vector3fVector& positions,
          const Triangle& triangle,
@@ -87,14 +114,13 @@ isEdgeOn(const Vector3fVector& positions,
                                     positions[triangle[1]].cast<double>() +
                                     positions[triangle[2]].cast<double>()) /
                                    3.0;
-  const Eigen::Vector3d sight = (centroid - eye).normalized();
-  return std::abs(sight.dot(normal.cast<double>())) < min_cos;
+  return isEdgeOn(normal, centroid, eye, min_cos);
 }
 
 /** Normal, area and edge-on flag of one triangle, as computeTriangleNormalsAndEdgeOn()
- * gives them (the normal NaN for a degenerate triangle): triangleNormal() and
- * isEdgeOn() in one pass, the corners read and the centroid computed once (the same
- * expressions, so the same values). */
+ * gives them (the normal NaN for a degenerate triangle), its corners read and its
+ * centroid computed once (the same expressions as the two functions above, so the same
+ * values). */
 inline void
 triangleNormalAndEdgeOn(const Vector3fVector& positions,
                         const Triangle& triangle,
@@ -104,28 +130,11 @@ triangleNormalAndEdgeOn(const Vector3fVector& positions,
                         double& area,
                         std::uint8_t& edge_on)
 {
-  const Eigen::Vector3d a = positions[triangle[0]].cast<double>();
-  const Eigen::Vector3d b = positions[triangle[1]].cast<double>();
-  const Eigen::Vector3d c = positions[triangle[2]].cast<double>();
-  Eigen::Vector3d n = (b - a).cross(c - a);
-  const double twice_area = n.norm();
-  area = 0.5 * twice_area;
-  if (!(twice_area > 0.0) || !std::isfinite(twice_area)) {
-    normal = Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN());
-    edge_on = 1;
-    return;
-  }
-  n /= twice_area;
-  const Eigen::Vector3d centroid = (a + b + c) / 3.0;
-  if (n.dot(centroid - eye) > 0.0)
-    n = -n;
-  normal = n.cast<float>();
-  if (!normal.allFinite()) {
-    edge_on = 1;
-    return;
-  }
-  const Eigen::Vector3d sight = (centroid - eye).normalized();
-  edge_on = std::abs(sight.dot(normal.cast<double>())) < min_cos;
+  normal = Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN());
+  Eigen::Vector3d centroid;
+  edge_on = triangleNormal(positions, triangle, eye, normal, area, centroid)
+                ? isEdgeOn(normal, centroid, eye, min_cos)
+                : 1;
 }
 
 /** eq. 2-3 at one vertex over its triangles [begin, end), in that order. */
