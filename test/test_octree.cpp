@@ -424,6 +424,27 @@ TEST(OctreePointCloudNormalVariance, InvalidPointsSkipped)
   expectPartition(*subset, expected);
 }
 
+/** Every field of two trees' leaves and orderings, bit for bit. */
+void
+expectSameLeaves(const Octree& a, const Octree& b)
+{
+  EXPECT_EQ(a.getOrderedIndices(), b.getOrderedIndices());
+  ASSERT_EQ(a.getAdaptiveLeaves().size(), b.getAdaptiveLeaves().size());
+  for (std::size_t l = 0; l < a.getAdaptiveLeaves().size(); ++l) {
+    SCOPED_TRACE(l);
+    const AdaptiveLeaf& x = a.getAdaptiveLeaves()[l];
+    const AdaptiveLeaf& y = b.getAdaptiveLeaves()[l];
+    EXPECT_EQ(x.key, y.key);
+    EXPECT_EQ(x.depth, y.depth);
+    EXPECT_EQ(x.begin, y.begin);
+    EXPECT_EQ(x.end, y.end);
+    EXPECT_EQ(x.area, y.area);
+    EXPECT_EQ(x.sigma_theta, y.sigma_theta);
+    EXPECT_EQ(x.sigma_phi, y.sigma_phi);
+    EXPECT_EQ(x.normal, y.normal);
+  }
+}
+
 TEST(OctreePointCloudNormalVariance, RecomputeWithAnotherThreshold)
 {
   // computeAdaptiveLeaves() may run again on the same tree: the result is that of a
@@ -433,18 +454,8 @@ TEST(OctreePointCloudNormalVariance, RecomputeWithAnotherThreshold)
   ASSERT_EQ(tree->getAdaptiveLeaves().size(), 1u);
   tree->computeAdaptiveLeaves(kPaperThreshold, kMinPoints);
   const auto fresh = buildOctree(scene, 0.05, kPaperThreshold);
-  ASSERT_EQ(tree->getAdaptiveLeaves().size(), fresh->getAdaptiveLeaves().size());
   ASSERT_GT(tree->getAdaptiveLeaves().size(), 1u);
-  EXPECT_EQ(tree->getOrderedIndices(), fresh->getOrderedIndices());
-  for (std::size_t l = 0; l < fresh->getAdaptiveLeaves().size(); ++l) {
-    const AdaptiveLeaf& a = tree->getAdaptiveLeaves()[l];
-    const AdaptiveLeaf& b = fresh->getAdaptiveLeaves()[l];
-    EXPECT_EQ(a.key, b.key);
-    EXPECT_EQ(a.depth, b.depth);
-    EXPECT_EQ(a.begin, b.begin);
-    EXPECT_EQ(a.end, b.end);
-    EXPECT_EQ(a.sigma_theta, b.sigma_theta);
-  }
+  expectSameLeaves(*tree, *fresh);
 }
 
 // The normals as plain 3-vectors (the form SelectiveSegmentation lends without a copy)
@@ -465,22 +476,10 @@ TEST(OctreePointCloudNormalVariance, NormalVectorsGiveTheSameTree)
   from_vectors.computeAdaptiveLeaves(kPaperThreshold, kMinPoints);
   expectPartition(from_vectors, validPoints(scene));
   ASSERT_GT(from_cloud->getAdaptiveLeaves().size(), 1u);
-  ASSERT_EQ(from_vectors.getAdaptiveLeaves().size(),
-            from_cloud->getAdaptiveLeaves().size());
-  EXPECT_EQ(from_vectors.getOrderedIndices(), from_cloud->getOrderedIndices());
+  expectSameLeaves(from_vectors, *from_cloud);
   double total_area = 0.0;
-  for (std::size_t l = 0; l < from_cloud->getAdaptiveLeaves().size(); ++l) {
-    const AdaptiveLeaf& a = from_vectors.getAdaptiveLeaves()[l];
-    const AdaptiveLeaf& b = from_cloud->getAdaptiveLeaves()[l];
-    EXPECT_EQ(a.key, b.key);
-    EXPECT_EQ(a.begin, b.begin);
-    EXPECT_EQ(a.end, b.end);
-    EXPECT_EQ(a.area, b.area);
-    EXPECT_EQ(a.sigma_theta, b.sigma_theta);
-    EXPECT_EQ(a.sigma_phi, b.sigma_phi);
-    EXPECT_EQ(a.normal, b.normal);
-    total_area += a.area;
-  }
+  for (const AdaptiveLeaf& leaf : from_cloud->getAdaptiveLeaves())
+    total_area += leaf.area;
   // eq. 6: the leaves' areas add up to the areas of the valid points.
   double expected_area = 0.0;
   for (const auto i : validPoints(scene))
@@ -721,27 +720,6 @@ TEST(OctreePointCloudNormalVariance, SensorOrientation)
   const auto unaware = buildOctree(rotated, 0.01, M_PI);
   EXPECT_GT(std::abs(unaware->getAdaptiveLeaves()[0].sigma_phi - expected.sigma_phi),
             0.01f);
-}
-
-/** Every field of two trees' leaves and orderings, bit for bit. */
-void
-expectSameLeaves(const Octree& a, const Octree& b)
-{
-  EXPECT_EQ(a.getOrderedIndices(), b.getOrderedIndices());
-  ASSERT_EQ(a.getAdaptiveLeaves().size(), b.getAdaptiveLeaves().size());
-  for (std::size_t l = 0; l < a.getAdaptiveLeaves().size(); ++l) {
-    SCOPED_TRACE(l);
-    const AdaptiveLeaf& x = a.getAdaptiveLeaves()[l];
-    const AdaptiveLeaf& y = b.getAdaptiveLeaves()[l];
-    EXPECT_EQ(x.key, y.key);
-    EXPECT_EQ(x.depth, y.depth);
-    EXPECT_EQ(x.begin, y.begin);
-    EXPECT_EQ(x.end, y.end);
-    EXPECT_EQ(x.area, y.area);
-    EXPECT_EQ(x.sigma_theta, y.sigma_theta);
-    EXPECT_EQ(x.sigma_phi, y.sigma_phi);
-    EXPECT_EQ(x.normal, y.normal);
-  }
 }
 
 // addPointsAndComputeAdaptiveLeaves() computes the normal angles while it builds the
