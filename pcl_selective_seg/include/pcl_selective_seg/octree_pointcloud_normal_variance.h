@@ -74,6 +74,11 @@ using ScratchVector = std::vector<T, DefaultInitAllocator<T>>;
  *
  * The bounding box is taken from the points before insertion, so the tree, its leaves
  * and their order do not depend on the order of the points.
+ *
+ * Use: setInputCloud(), setInputNormals(), then addPointsFromInputCloud() and
+ * computeAdaptiveLeaves() (which may run again with other thresholds), or
+ * addPointsAndComputeAdaptiveLeaves(), which gives the same tree and leaves and on
+ * several threads computes the normal angles while it builds the tree.
  */
 template <typename PointT>
 class OctreePointCloudNormalVariance
