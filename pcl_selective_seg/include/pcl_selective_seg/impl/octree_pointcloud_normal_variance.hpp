@@ -214,17 +214,20 @@ OctreePointCloudNormalVariance<PointT>::insertPoints(bool with_angles)
     leaf_indices[k] = order[k].second;
   // The first entry of each leaf; the points' codes are freed before the scratch of the
   // angles is allocated (the peak of memory).
+  const auto starts_voxel = [&](std::size_t k) {
+    return k == 0 || order[k].first != order[k - 1].first;
+  };
   std::size_t num_voxels = 0;
 #ifdef _OPENMP
 #pragma omp parallel for num_threads(num_threads_) schedule(static) \
     reduction(+ : num_voxels)
 #endif
   for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(n); ++k)
-    num_voxels += k == 0 || order[k].first != order[k - 1].first;
-  std::vector<pcl::uindex_t> voxel_begin;
+    num_voxels += starts_voxel(static_cast<std::size_t>(k));
+  std::vector<pcl::uindex_t> voxel_begin; // exactly sized: it lives beside the scratch
   voxel_begin.reserve(num_voxels);
   for (std::size_t k = 0; k < n; ++k)
-    if (k == 0 || order[k].first != order[k - 1].first)
+    if (starts_voxel(k))
       voxel_begin.push_back(static_cast<pcl::uindex_t>(k));
   decltype(order)().swap(order);
   // The same tree as PCL's point-by-point insertion (addPointIdx()), built along the
