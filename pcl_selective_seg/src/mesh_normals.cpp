@@ -226,10 +226,8 @@ updateTriangleNormalsAndEdgeOn(const Vector3fVector& positions,
   std::vector<double> new_areas(n_new);
   std::vector<std::uint8_t> new_edge_on(n_new);
   const auto n_old = static_cast<std::ptrdiff_t>(old_to_new.size());
-  const int moving = static_cast<std::size_t>(n_old) >= detail::kMinParallelItems
-                         ? threads(num_threads)
-                         : 1;
-#pragma omp parallel for num_threads(moving) schedule(static)
+#pragma omp parallel for num_threads(threads(num_threads)) schedule(static) \
+    if (old_to_new.size() >= detail::kMinParallelItems)
   for (std::ptrdiff_t k = 0; k < n_old; ++k) {
     const pcl::index_t t = old_to_new[k];
     if (t < 0)
