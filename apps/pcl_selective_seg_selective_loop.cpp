@@ -52,7 +52,7 @@ struct Options {
   double range_noise = 0.0005;
   double min_voxel_factor = 2.0;
   double step_scale = 1.0;
-  double window_steps = 2.0;
+  double window_steps = 1.0;
   double progressive = 1.0;
   double seed = -1.0; ///< < 0: the scenes' own seeds
   pcl::selective_seg::RegionOfInterestParameters regions;

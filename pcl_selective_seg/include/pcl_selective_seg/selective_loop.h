@@ -102,8 +102,10 @@ struct PCL_EXPORTS SelectiveLoopParameters {
    * of boundary accuracy (edges across holes). */
   double boundary_edge_steps = 4.0;
   /** \brief Evidence tiles (RegionOfInterestParameters::max_window_size) of this
-   * many coarse steps; 0: keep regions.max_window_size. */
-  double window_steps = 2.0;
+   * many coarse steps (one: each window wraps the evidence at the resolution the
+   * coarse scan knows it; docs/selective_sensing.md); 0: keep
+   * regions.max_window_size. */
+  double window_steps = 1.0;
   SelectiveSegmentationParameters segmentation;
   /** \brief The regions of interest; target_step, max_points and sample_yield are set
    * by the loop (the yield from the coarse scan, then corrected each round by the
