@@ -176,8 +176,11 @@ OctreePointCloudNormalVariance<PointT>::insertPoints(bool with_angles)
   if (!std::is_sorted(valid.begin(), valid.end()))
     std::sort(valid.begin(), valid.end());
   std::vector<std::pair<std::uint64_t, pcl::index_t>> order(valid.size());
+  // The passes over the points below take microseconds on small clouds: less than
+  // starting a team of threads.
+  const bool parallel = valid.size() >= detail::kMinParallelItems;
 #ifdef _OPENMP
-#pragma omp parallel for num_threads(num_threads_) schedule(static)
+#pragma omp parallel for num_threads(num_threads_) schedule(static) if (parallel)
 #endif
   for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(valid.size()); ++k) {
     pcl::octree::OctreeKey key;
@@ -208,7 +211,7 @@ OctreePointCloudNormalVariance<PointT>::insertPoints(bool with_angles)
   pcl::Indices& leaf_indices = with_angles ? ordered_indices_ : voxel_indices_;
   leaf_indices.resize(n);
 #ifdef _OPENMP
-#pragma omp parallel for num_threads(num_threads_) schedule(static)
+#pragma omp parallel for num_threads(num_threads_) schedule(static) if (parallel)
 #endif
   for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(n); ++k)
     leaf_indices[k] = order[k].second;
@@ -220,7 +223,7 @@ OctreePointCloudNormalVariance<PointT>::insertPoints(bool with_angles)
   std::size_t num_voxels = 0;
 #ifdef _OPENMP
 #pragma omp parallel for num_threads(num_threads_) schedule(static) \
-    reduction(+ : num_voxels)
+    reduction(+ : num_voxels) if (parallel)
 #endif
   for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(n); ++k)
     num_voxels += starts_voxel(static_cast<std::size_t>(k));
@@ -493,8 +496,9 @@ OctreePointCloudNormalVariance<PointT>::computeAdaptiveLeaves(
   while (!level.empty()) {
     stats.resize(level.size());
     split.resize(level.size());
+    const bool parallel = level.size() > 1; // one node (the root) is one thread's work
 #ifdef _OPENMP
-#pragma omp parallel for num_threads(num_threads_) schedule(dynamic, 8)
+#pragma omp parallel for num_threads(num_threads_) schedule(dynamic, 8) if (parallel)
 #endif
     for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(level.size()); ++i) {
       const auto range = nodeRange(level[i].node);
@@ -538,7 +542,7 @@ OctreePointCloudNormalVariance<PointT>::computeAdaptiveLeaves(
     leaves_.reserve(first_new_leaf + num_new_leaves);
     leaves_.resize(first_new_leaf + num_new_leaves);
 #ifdef _OPENMP
-#pragma omp parallel for num_threads(num_threads_) schedule(dynamic, 64)
+#pragma omp parallel for num_threads(num_threads_) schedule(dynamic, 64) if (parallel)
 #endif
     for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(level.size()); ++i)
       if (!split[i])
