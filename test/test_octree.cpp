@@ -785,6 +785,72 @@ TEST(OctreePointCloudNormalVariance, OneCallGivesTheSameLeaves)
   EXPECT_TRUE(none.getAdaptiveLeaves().empty());
 }
 
+// Every adaptive leaf is a node of the PCL tree: its points are exactly the valid
+// points whose finest voxel lies in the node of its key and depth (the leaves are found
+// from the finest voxels' codes, not by walking the tree). Checked on a deep tree built
+// in one call and in two, and on a tree filled by PCL's point-by-point insertion, which
+// gives the same leaves.
+TEST(OctreePointCloudNormalVariance, LeavesAreNodesOfTheTree)
+{
+  Scene scene;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(-1.f, 1.f);
+  for (int i = 0; i < 6000; ++i) {
+    const float x = u(rng), y = u(rng);
+    const float z = 3.f + 0.3f * std::sin(5.f * x) + 0.2f * (y > 0.3f ? y : 0.f);
+    const Eigen::Vector3f n = Eigen::Vector3f(1.5f * std::cos(5.f * x) + 0.05f * u(rng),
+                                              (y > 0.3f ? 0.2f : 0.f) + 0.05f * u(rng),
+                                              -1.f)
+                                  .normalized();
+    scene.add(Eigen::Vector3f(x, y, z), n, 1e-4 * (1.5 + u(rng)));
+  }
+  (*scene.areas)[42] = 0.0; // not inserted
+  const double resolution = 0.004;
+  const auto valid = validPoints(scene);
+  const auto two_calls = buildOctree(scene, resolution, kPaperThreshold);
+  Octree one_call(resolution);
+  one_call.setNumberOfThreads(2);
+  one_call.setInputCloud(scene.cloud);
+  one_call.setInputNormals(scene.normals, scene.areas);
+  ASSERT_TRUE(one_call.addPointsAndComputeAdaptiveLeaves(kPaperThreshold, kMinPoints));
+  ASSERT_GE(one_call.getTreeDepth(), 8u);
+  for (const Octree* tree : {static_cast<const Octree*>(two_calls.get()),
+                             static_cast<const Octree*>(&one_call)}) {
+    const unsigned depth = tree->getTreeDepth();
+    std::vector<pcl::octree::OctreeKey> keys;
+    for (const pcl::index_t i : valid)
+      keys.push_back(finestKey(*tree, (*scene.cloud)[i]));
+    const auto& leaves = tree->getAdaptiveLeaves();
+    ASSERT_GT(leaves.size(), 200u);
+    std::set<std::uint32_t> depths;
+    for (const AdaptiveLeaf& leaf : leaves) {
+      depths.insert(leaf.depth);
+      std::vector<pcl::index_t> in_node;
+      for (std::size_t k = 0; k < valid.size(); ++k)
+        if (inNode(keys[k], depth - leaf.depth, leaf.key))
+          in_node.push_back(valid[k]);
+      auto points = leafPoints(*tree, leaf);
+      std::sort(points.begin(), points.end());
+      ASSERT_EQ(points, in_node) << "leaf at depth " << leaf.depth;
+    }
+    EXPECT_GE(depths.size(), 3u); // leaves at several depths
+    expectPartition(*tree, valid);
+  }
+  expectSameLeaves(one_call, *two_calls);
+  // PCL's insertion, point by point in index order, into the same box.
+  Octree pointwise(resolution);
+  pointwise.setInputCloud(scene.cloud);
+  pointwise.setInputNormals(scene.normals, scene.areas);
+  double min_x, min_y, min_z, max_x, max_y, max_z;
+  two_calls->getBoundingBox(min_x, min_y, min_z, max_x, max_y, max_z);
+  pointwise.defineBoundingBox(min_x, min_y, min_z, max_x, max_y, max_z);
+  for (const pcl::index_t i : valid)
+    pointwise.addPointFromCloud(i, nullptr);
+  ASSERT_EQ(pointwise.getTreeDepth(), two_calls->getTreeDepth());
+  pointwise.computeAdaptiveLeaves(kPaperThreshold, kMinPoints);
+  expectSameLeaves(pointwise, *two_calls);
+}
+
 int
 main(int argc, char** argv)
 {

@@ -14,6 +14,7 @@
 #include <pcl/point_types.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <limits>
 #include <memory>
 #include <thread>
@@ -166,8 +167,9 @@ protected:
 
   bool isValidPoint(pcl::index_t index) const;
 
-  /** \brief Order the points depth first. */
-  void orderPoints(const pcl::octree::OctreeNode* node);
+  /** \brief Order the points depth first, and list the finest voxels (leaf nodes) in
+   * that order; \a key is the key of \a node. */
+  void orderPoints(const pcl::octree::OctreeNode* node, pcl::octree::OctreeKey key);
 
   /** \brief Normals, angles and areas of the ordered points (in parallel). */
   void computeNormalAngles();
@@ -197,13 +199,11 @@ protected:
                     std::size_t end,
                     double split_above = std::numeric_limits<double>::infinity()) const;
 
-  /** \brief First and one-past-last ordered point under a node. */
-  std::pair<std::size_t, std::size_t>
-  nodeRange(const pcl::octree::OctreeNode* node) const;
-
-  /** \brief A node met while descending from the root, with its point range. */
+  /** \brief A node met while descending from the root: its finest voxels
+   * [first_voxel, end_voxel) (a run of voxel_codes_) and its point range. */
   struct PendingNode {
-    const pcl::octree::OctreeNode* node = nullptr;
+    std::size_t first_voxel = 0;
+    std::size_t end_voxel = 0;
     pcl::octree::OctreeKey key;
     std::uint32_t depth = 0;
     std::size_t begin = 0;
@@ -234,10 +234,18 @@ private:
    * (addPointsAndComputeAdaptiveLeaves() stores them in ordered_indices_). */
   pcl::Indices voxel_indices_;
   pcl::Indices ordered_indices_;
+  /** The finest voxels (the tree's leaf nodes) in depth-first order: their Morton codes
+   * (increasing) and the first of their points in ordered_indices_. A node of the tree
+   * is a run of them (its code prefix), so computeAdaptiveLeaves() finds a node's
+   * points and children without walking the tree. Kept while computeAdaptiveLeaves()
+   * needs them, like the scratch. */
+  std::vector<std::uint64_t> voxel_codes_;
+  std::vector<pcl::uindex_t> voxel_first_;
   /** ordered_indices_ and the scratch were made by insertPoints(true) for the next
    * computeAdaptiveLeaves(). */
   bool angles_ready_ = false;
-  /** The leaf containers view ordered_indices_ (insertPoints(true)), not voxel_indices_.
+  /** The leaf containers view ordered_indices_ (insertPoints(true)), not
+   * voxel_indices_.
    */
   bool leaves_view_ordered_ = false;
   detail::ScratchVector<Eigen::Vector3d> ordered_normals_; ///< sensor frame, reversed

@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <tuple>
 
 namespace pcl {
 namespace selective_seg {
@@ -253,6 +254,8 @@ OctreePointCloudNormalVariance<PointT>::insertPoints(bool with_angles)
         level = depth - 1 - static_cast<unsigned>(detail::bitWidth(differ) - 1) / 3;
       }
       previous = code;
+      if (with_angles)
+        voxel_codes_[v] = code;
       const auto child = [&](unsigned d) {
         return static_cast<unsigned char>((code >> (3 * (depth - 1 - d))) & 7u);
       };
@@ -276,6 +279,7 @@ OctreePointCloudNormalVariance<PointT>::insertPoints(bool with_angles)
   // values), computed by the other threads while the calling thread builds the tree,
   // which then joins them.
   voxel_indices_ = pcl::Indices();
+  voxel_codes_.resize(num_voxels);
   resizeScratch(n);
   const Eigen::Matrix3d to_sensor =
       sensor_orientation_.toRotationMatrix().transpose().template cast<double>();
@@ -295,25 +299,32 @@ OctreePointCloudNormalVariance<PointT>::insertPoints(bool with_angles)
     for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(n); ++k)
       computeNormalAngle(static_cast<std::size_t>(k), to_sensor, ordered_indices_.data(), n);
   }
+  voxel_first_ = std::move(voxel_begin);
   angles_ready_ = true;
   return true;
 }
 
 template <typename PointT>
 void
-OctreePointCloudNormalVariance<PointT>::orderPoints(const pcl::octree::OctreeNode* node)
+OctreePointCloudNormalVariance<PointT>::orderPoints(const pcl::octree::OctreeNode* node,
+                                                    pcl::octree::OctreeKey key)
 {
   if (node->getNodeType() == pcl::octree::LEAF_NODE) {
     auto& container =
         const_cast<LeafNode*>(static_cast<const LeafNode*>(node))->getContainer();
     container.setFirstOrderedPoint(ordered_indices_.size());
+    voxel_codes_.push_back(detail::mortonCode(key));
+    voxel_first_.push_back(static_cast<pcl::uindex_t>(ordered_indices_.size()));
     ordered_indices_.insert(ordered_indices_.end(), container.begin(), container.end());
     return;
   }
   const auto* branch = static_cast<const BranchNode*>(node);
   for (unsigned char c = 0; c < 8; ++c)
-    if (const auto* child = branch->getChildPtr(c))
-      orderPoints(child);
+    if (const auto* child = branch->getChildPtr(c)) {
+      pcl::octree::OctreeKey child_key = key;
+      child_key.pushBranch(c);
+      orderPoints(child, child_key);
+    }
 }
 
 template <typename PointT>
@@ -362,33 +373,6 @@ OctreePointCloudNormalVariance<PointT>::computeNormalAngles()
 #endif
   for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(n); ++k)
     computeNormalAngle(static_cast<std::size_t>(k), to_sensor, ordered_indices_.data(), n);
-}
-
-template <typename PointT>
-std::pair<std::size_t, std::size_t>
-OctreePointCloudNormalVariance<PointT>::nodeRange(
-    const pcl::octree::OctreeNode* node) const
-{
-  const auto* first = node;
-  while (first->getNodeType() == pcl::octree::BRANCH_NODE) {
-    const auto* branch = static_cast<const BranchNode*>(first);
-    unsigned char c = 0;
-    while (!branch->getChildPtr(c))
-      ++c;
-    first = branch->getChildPtr(c);
-  }
-  const auto* last = node;
-  while (last->getNodeType() == pcl::octree::BRANCH_NODE) {
-    const auto* branch = static_cast<const BranchNode*>(last);
-    int c = 7;
-    while (!branch->getChildPtr(static_cast<unsigned char>(c)))
-      --c;
-    last = branch->getChildPtr(static_cast<unsigned char>(c));
-  }
-  const auto& first_leaf = static_cast<const LeafNode*>(first)->getContainer();
-  const auto& last_leaf = static_cast<const LeafNode*>(last)->getContainer();
-  return {first_leaf.getFirstOrderedPoint(),
-          last_leaf.getFirstOrderedPoint() + last_leaf.getSize()};
 }
 
 template <typename PointT>
@@ -476,7 +460,9 @@ OctreePointCloudNormalVariance<PointT>::computeAdaptiveLeaves(
   if (!angles_ready) {
     ordered_indices_.reserve(this->indices_ ? this->indices_->size()
                                             : this->input_->size());
-    orderPoints(this->root_node_);
+    voxel_codes_.reserve(this->leaf_count_);
+    voxel_first_.reserve(this->leaf_count_);
+    orderPoints(this->root_node_, pcl::octree::OctreeKey());
     computeNormalAngles();
   }
   const std::size_t min_points = std::max<std::size_t>(min_points_to_split, 2);
@@ -487,66 +473,104 @@ OctreePointCloudNormalVariance<PointT>::computeAdaptiveLeaves(
   // Level by level from the root: the statistics of a level's nodes in parallel (each
   // node one sequential pass, so the same sums for any thread count), then the
   // decisions in order. A node splits while sigma_theta or sigma_phi > max_std_dev
-  // (eq. 5) and it is a branch with at least min_points points.
+  // (eq. 5) and it is a branch with at least min_points points. A node is a run of the
+  // finest voxels (their codes share its prefix); a branch is a node above the leaf
+  // level, and its children are the runs of the next three bits of the codes.
+  const std::size_t n = ordered_indices_.size();
+  const std::size_t num_voxels = voxel_codes_.size();
+  const auto tree_depth = static_cast<std::uint32_t>(this->octree_depth_);
+  const auto points_of = [&](const PendingNode& node) {
+    return std::make_pair(static_cast<std::size_t>(voxel_first_[node.first_voxel]),
+                          node.end_voxel < num_voxels
+                              ? static_cast<std::size_t>(voxel_first_[node.end_voxel])
+                              : n);
+  };
+  // Calls f(child's first voxel, its end voxel, its number) for each child of a branch,
+  // in the order of their numbers (PCL's child order: the codes' order).
+  const auto for_each_child = [&](const PendingNode& node, const auto& f) {
+    const unsigned shift = 3 * (tree_depth - 1 - node.depth);
+    for (std::size_t v = node.first_voxel; v < node.end_voxel;) {
+      const std::uint64_t prefix = voxel_codes_[v] >> shift;
+      const std::size_t end = static_cast<std::size_t>(
+          std::lower_bound(voxel_codes_.begin() + static_cast<std::ptrdiff_t>(v),
+                           voxel_codes_.begin() +
+                               static_cast<std::ptrdiff_t>(node.end_voxel),
+                           (prefix + 1) << shift) -
+          voxel_codes_.begin());
+      f(v, end, static_cast<unsigned char>(prefix & 7u));
+      v = end;
+    }
+  };
   std::vector<PendingNode> level(1), next;
-  level[0].node = this->root_node_;
+  level[0].first_voxel = 0;
+  level[0].end_voxel = num_voxels;
   std::vector<NodeStatistics> stats;
   std::vector<std::uint8_t> split;
-  std::vector<std::size_t> slot; // where a node kept as a leaf goes in leaves_
+  // A leaf's place in leaves_; a branch's number of children, then its first child's
+  // place in next.
+  std::vector<std::size_t> slot;
   while (!level.empty()) {
     stats.resize(level.size());
     split.resize(level.size());
+    slot.resize(level.size());
     const bool parallel = level.size() > 1; // one node (the root) is one thread's work
 #ifdef _OPENMP
 #pragma omp parallel for num_threads(num_threads_) schedule(dynamic, 8) if (parallel)
 #endif
     for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(level.size()); ++i) {
-      const auto range = nodeRange(level[i].node);
-      level[i].begin = range.first;
-      level[i].end = range.second;
+      PendingNode& node = level[i];
+      std::tie(node.begin, node.end) = points_of(node);
       // A node that may split needs its sigmas only until one exceeds the threshold.
-      const bool can_split = level[i].node->getNodeType() == pcl::octree::BRANCH_NODE &&
-                             range.second - range.first >= min_points;
-      stats[i] = computeStatistics(range.first,
-                                   range.second,
-                                   can_split && finite_weights ? max_std_dev : kNever);
+      const bool can_split =
+          node.depth < tree_depth && node.end - node.begin >= min_points;
+      stats[i] = computeStatistics(
+          node.begin, node.end, can_split && finite_weights ? max_std_dev : kNever);
       const bool varies =
           stats[i].sigma_theta > max_std_dev || stats[i].sigma_phi > max_std_dev;
       split[i] = varies && can_split;
+      std::size_t num_children = 0;
+      if (split[i])
+        for_each_child(
+            node, [&](std::size_t, std::size_t, unsigned char) { ++num_children; });
+      slot[i] = num_children;
     }
-    next.clear();
+    // Places: leaves after the earlier levels' ones, children in the order of their
+    // parents.
     const std::size_t first_new_leaf = leaves_.size();
-    slot.resize(level.size());
-    std::size_t num_new_leaves = 0;
+    std::size_t num_new_leaves = 0, num_children = 0;
     for (std::size_t i = 0; i < level.size(); ++i) {
-      if (!split[i]) {
+      if (split[i]) {
+        const std::size_t count = slot[i];
+        slot[i] = num_children;
+        num_children += count;
+      } else
         slot[i] = first_new_leaf + num_new_leaves++;
-        continue;
-      }
-      const PendingNode& node = level[i];
-      const auto* branch = static_cast<const BranchNode*>(node.node);
-      for (unsigned char c = 0; c < 8; ++c) {
-        if (const auto* child = branch->getChildPtr(c)) {
-          PendingNode pending;
-          pending.node = child;
-          pending.key = node.key;
-          pending.key.pushBranch(c);
-          pending.depth = node.depth + 1;
-          next.push_back(pending);
-        }
-      }
     }
+    next.resize(num_children);
     // Grown by exactly this level's leaves: doubling would hold three times the leaves
     // at the pipeline's peak of memory. The leaves (their areas are one pass over
-    // their points) are made in parallel, each into its own slot.
+    // their points) and the children are made in parallel, each into its own slot.
     leaves_.reserve(first_new_leaf + num_new_leaves);
     leaves_.resize(first_new_leaf + num_new_leaves);
 #ifdef _OPENMP
 #pragma omp parallel for num_threads(num_threads_) schedule(dynamic, 64) if (parallel)
 #endif
-    for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(level.size()); ++i)
-      if (!split[i])
-        leaves_[slot[i]] = makeLeaf(level[i], stats[i]);
+    for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(level.size()); ++i) {
+      const PendingNode& node = level[i];
+      if (!split[i]) {
+        leaves_[slot[i]] = makeLeaf(node, stats[i]);
+        continue;
+      }
+      std::size_t place = slot[i];
+      for_each_child(node, [&](std::size_t first, std::size_t end, unsigned char c) {
+        PendingNode& child = next[place++];
+        child.first_voxel = first;
+        child.end_voxel = end;
+        child.key = node.key;
+        child.key.pushBranch(c);
+        child.depth = node.depth + 1;
+      });
+    }
     // Depth-first order: the leaves' point ranges are disjoint and ordered so; each
     // level's leaves come in that order.
     std::inplace_merge(
@@ -568,6 +592,8 @@ OctreePointCloudNormalVariance<PointT>::releaseScratch()
   decltype(ordered_theta_)().swap(ordered_theta_);
   decltype(ordered_phi_)().swap(ordered_phi_);
   decltype(ordered_weights_)().swap(ordered_weights_);
+  decltype(voxel_codes_)().swap(voxel_codes_);
+  decltype(voxel_first_)().swap(voxel_first_);
 }
 
 template <typename PointT>
