@@ -67,7 +67,6 @@ const std::vector<std::string> kSwitches = {"-ignore_viewpoint", "-h", "--help"}
 void
 printHelp(const char* program)
 {
-  const SelectiveSegmentationParameters d;
   print_info(
       "Segment a 3-D scan seen from one sensor viewpoint into surface segments.\n\n"
       "Usage: %s INPUT [options]\n"

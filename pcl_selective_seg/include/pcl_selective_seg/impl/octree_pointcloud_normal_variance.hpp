@@ -179,7 +179,7 @@ OctreePointCloudNormalVariance<PointT>::insertPoints(bool with_angles)
   std::vector<std::pair<std::uint64_t, pcl::index_t>> order(valid.size());
   // The passes over the points below take microseconds on small clouds: less than
   // starting a team of threads.
-  const bool parallel = valid.size() >= detail::kMinParallelItems;
+  [[maybe_unused]] const bool parallel = valid.size() >= detail::kMinParallelItems;
 #ifdef _OPENMP
 #pragma omp parallel for num_threads(num_threads_) schedule(static) if (parallel)
 #endif
@@ -513,7 +513,8 @@ OctreePointCloudNormalVariance<PointT>::computeAdaptiveLeaves(
     stats.resize(level.size());
     split.resize(level.size());
     slot.resize(level.size());
-    const bool parallel = level.size() > 1; // one node (the root) is one thread's work
+    // One node (the root) is one thread's work. (Read by the pragmas only.)
+    [[maybe_unused]] const bool parallel = level.size() > 1;
 #ifdef _OPENMP
 #pragma omp parallel for num_threads(num_threads_) schedule(dynamic, 8) if (parallel)
 #endif
