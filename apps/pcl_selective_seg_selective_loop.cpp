@@ -23,6 +23,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <sstream>
@@ -78,7 +79,7 @@ printHelp(const char* program)
       "scans.\n\n"
       "Usage: %s -out FOLDER [options]\n"
       "  -out FOLDER            where table.md, <scene>.dat, clouds and windows go "
-      "(must exist)\n"
+      "(made if missing)\n"
       "  -scenes a,b            scenes among cube, chair, door (default all three)\n"
       "  -iterations N          refinement rounds (default 3)\n"
       "  -coarse_factor X       coarse step = X times the fine step (default 3)\n"
@@ -109,7 +110,8 @@ printHelp(const char* program)
 bool
 parseOptions(int argc, char** argv, Options& opt)
 {
-  for (int i = 1; i < argc; ++i) {
+  // Every option takes a value.
+  for (int i = 1; i < argc; i += 2) {
     const std::string a = argv[i];
     const bool known = a == "-out" || a == "-scenes" || a == "-iterations" ||
                        a == "-coarse_factor" || a == "-budget_fraction" ||
@@ -128,7 +130,6 @@ parseOptions(int argc, char** argv, Options& opt)
                   a.c_str());
       return false;
     }
-    ++i;
   }
   parse_argument(argc, argv, "-out", opt.out);
   if (opt.out.empty()) {
@@ -231,11 +232,14 @@ tableRow(const std::string& scene,
 bool
 savePcd(const std::string& path, const pcl::PointCloud<pcl::PointXYZL>& cloud)
 {
+  bool ok = false;
   try {
-    return pcl::io::savePCDFileBinary(path, cloud) == 0;
+    ok = pcl::io::savePCDFileBinary(path, cloud) == 0;
   } catch (const pcl::IOException&) {
-    return false;
   }
+  if (!ok)
+    print_error("Cannot write '%s'.\n", path.c_str());
+  return ok;
 }
 
 /** Run one scene; appends its rows to \a table. */
@@ -442,6 +446,16 @@ main(int argc, char** argv)
   opt.regions = sim::loopRegionParameters();
   if (!parseOptions(argc, argv, opt))
     return kUsageError;
+  // The output folder, made if missing, before any scan is simulated.
+  std::error_code ec;
+  std::filesystem::create_directories(opt.out, ec);
+  if (ec || !std::filesystem::is_directory(opt.out)) {
+    print_error("Cannot make the output folder '%s'%s%s: give -out a writable folder.\n",
+                opt.out.c_str(),
+                ec ? ": " : "",
+                ec ? ec.message().c_str() : "");
+    return kRuntimeError;
+  }
   std::string table =
       "| scene | strategy | points | of dense | time (s) | boundary accuracy, mean "
       "(mm) "
