@@ -722,25 +722,46 @@ TEST(OctreePointCloudNormalVariance, SensorOrientation)
             0.01f);
 }
 
+namespace {
+
+/** \a count points at uniform random (x, y) in [-1, 1]^2 and z = height(x, y), facing a
+ * sensor on the -z side: normal (s_x + noise u, s_y + noise u, -1), normalized, where
+ * (s_x, s_y) = slope(x, y) and u is uniform in [-1, 1]; areas 1e-4 (1.5 + u). */
+template <typename Height, typename Slope>
+Scene
+randomSheet(unsigned seed, int count, Height height, Slope slope, float noise)
+{
+  Scene scene;
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(-1.f, 1.f);
+  for (int i = 0; i < count; ++i) {
+    const float x = u(rng), y = u(rng);
+    const Eigen::Vector2f s = slope(x, y);
+    const Eigen::Vector3f n =
+        Eigen::Vector3f(s.x() + noise * u(rng), s.y() + noise * u(rng), -1.f)
+            .normalized();
+    scene.add(Eigen::Vector3f(x, y, height(x, y)), n, 1e-4 * (1.5 + u(rng)));
+  }
+  return scene;
+}
+
+} // namespace
+
 // addPointsAndComputeAdaptiveLeaves() computes the normal angles while it builds the
 // tree: the tree and leaves must be those of the two separate calls for any thread
 // count and sensor orientation, and a later computeAdaptiveLeaves() must start afresh.
 TEST(OctreePointCloudNormalVariance, OneCallGivesTheSameLeaves)
 {
   // A bumpy sheet with noisy normals, a few invalid points, and a turned sensor.
-  Scene scene;
-  std::mt19937 rng(11);
-  std::uniform_real_distribution<float> u(-1.f, 1.f);
-  for (int i = 0; i < 20000; ++i) {
-    const float x = u(rng), y = u(rng);
-    const float z = 3.f + 0.2f * std::sin(4.f * x) * std::cos(3.f * y);
-    const Eigen::Vector3f n =
-        Eigen::Vector3f(0.8f * std::cos(4.f * x) * std::cos(3.f * y) + 0.1f * u(rng),
-                        -0.6f * std::sin(4.f * x) * std::sin(3.f * y) + 0.1f * u(rng),
-                        -1.f)
-            .normalized();
-    scene.add(Eigen::Vector3f(x, y, z), n, 1e-4 * (1.5 + u(rng)));
-  }
+  Scene scene = randomSheet(
+      11,
+      20000,
+      [](float x, float y) { return 3.f + 0.2f * std::sin(4.f * x) * std::cos(3.f * y); },
+      [](float x, float y) {
+        return Eigen::Vector2f(0.8f * std::cos(4.f * x) * std::cos(3.f * y),
+                               -0.6f * std::sin(4.f * x) * std::sin(3.f * y));
+      },
+      0.1f);
   (*scene.normals)[17].normal_x = std::numeric_limits<float>::quiet_NaN();
   (*scene.areas)[99] = 0.0;
   const Eigen::Quaternionf q(
@@ -792,18 +813,17 @@ TEST(OctreePointCloudNormalVariance, OneCallGivesTheSameLeaves)
 // gives the same leaves.
 TEST(OctreePointCloudNormalVariance, LeavesAreNodesOfTheTree)
 {
-  Scene scene;
-  std::mt19937 rng(5);
-  std::uniform_real_distribution<float> u(-1.f, 1.f);
-  for (int i = 0; i < 6000; ++i) {
-    const float x = u(rng), y = u(rng);
-    const float z = 3.f + 0.3f * std::sin(5.f * x) + 0.2f * (y > 0.3f ? y : 0.f);
-    const Eigen::Vector3f n = Eigen::Vector3f(1.5f * std::cos(5.f * x) + 0.05f * u(rng),
-                                              (y > 0.3f ? 0.2f : 0.f) + 0.05f * u(rng),
-                                              -1.f)
-                                  .normalized();
-    scene.add(Eigen::Vector3f(x, y, z), n, 1e-4 * (1.5 + u(rng)));
-  }
+  // A wavy sheet with a crease at y = 0.3.
+  Scene scene = randomSheet(
+      5,
+      6000,
+      [](float x, float y) {
+        return 3.f + 0.3f * std::sin(5.f * x) + 0.2f * (y > 0.3f ? y : 0.f);
+      },
+      [](float x, float y) {
+        return Eigen::Vector2f(1.5f * std::cos(5.f * x), y > 0.3f ? 0.2f : 0.f);
+      },
+      0.05f);
   (*scene.areas)[42] = 0.0; // not inserted
   const double resolution = 0.004;
   const auto valid = validPoints(scene);

@@ -244,8 +244,7 @@ private:
   /** ordered_indices_ and the scratch were made by insertPoints(true) for the next
    * computeAdaptiveLeaves(). */
   bool angles_ready_ = false;
-  /** The leaf containers view ordered_indices_ (insertPoints(true)), not
-   * voxel_indices_.
+  /** The leaf containers view ordered_indices_ (insertPoints(true)), not voxel_indices_.
    */
   bool leaves_view_ordered_ = false;
   detail::ScratchVector<Eigen::Vector3d> ordered_normals_; ///< sensor frame, reversed
