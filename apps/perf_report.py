@@ -98,7 +98,8 @@ def markdown(context, runs, rows, memory, load=None):
            "one of them. Timings are never asserted in tests.", "",
            f"Machine: {context.get('num_cpus', '?')} CPUs at "
            f"{context.get('mhz_per_cpu', '?')} MHz, date {context.get('date', '?')}, "
-           f"OpenMP wait policy {os.environ.get('OMP_WAIT_POLICY') or 'default'}."
+           f"OpenMP wait policy {os.environ.get('OMP_WAIT_POLICY') or 'default'}, "
+           f"glibc tunables {os.environ.get('GLIBC_TUNABLES') or 'none'}."
            + load_note(load), "",
            "## Whole pipeline by size and stage (simulated door scans, Fig. 6)", "",
            "| points | Delaunay (s) | Normal Calc. (s) | Octree Gen. (s) | Merge Voxels (s) "
