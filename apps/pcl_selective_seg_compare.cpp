@@ -209,11 +209,14 @@ methods()
   robust2.edge_triangle_normal = EdgeTriangleNormal::VertexMean;
   SelectiveSegmentationParameters robust3 = robust2;
   robust3.normal_rings = 3;
+  SelectiveSegmentationParameters mean_frame = defaults;
+  mean_frame.normal_spread_frame = pcl::selective_seg::NormalSpreadFrame::MeanNormal;
   const auto selective = [](const SelectiveSegmentationParameters& p) {
     return [p](const Cloud::ConstPtr& c) { return runSelective(c, p); };
   };
   return {{"selective (paper)", selective(paper)},
           {"selective (default)", selective(defaults)},
+          {"selective (eq. 5 in the voxel's frame)", selective(mean_frame)},
           {"selective (rings 3)", selective(rings3)},
           {"selective (rings 2, vertex-mean eq. 8)", selective(robust2)},
           {"selective (rings 3, vertex-mean eq. 8)", selective(robust3)},

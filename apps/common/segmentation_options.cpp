@@ -13,6 +13,7 @@ using pcl::console::print_error;
 using pcl::console::print_info;
 using pcl::selective_seg::DelaunayBackend;
 using pcl::selective_seg::EdgeTriangleNormal;
+using pcl::selective_seg::NormalSpreadFrame;
 using pcl::selective_seg::SelectiveSegmentationParameters;
 
 constexpr double kDeg = M_PI / 180.0;
@@ -54,6 +55,7 @@ const std::vector<std::string>&
 segmentationFlags()
 {
   static const std::vector<std::string> flags = {"-split_deg",
+                                                 "-spread_frame",
                                                  "-merge_deg",
                                                  "-edge_deg",
                                                  "-incidence_deg",
@@ -77,6 +79,8 @@ printSegmentationHelp()
   print_info("  -split_deg X           octree split threshold on the normals' std dev "
              "[deg] (default %g)\n",
              d.max_normal_std_dev / kDeg);
+  print_info("  -spread_frame NAME     frame of the split test's normal angles: sensor "
+             "(paper) or mean_normal (default sensor)\n");
   print_info("  -merge_deg X           max angle between merged segment normals [deg] "
              "(default %g)\n",
              d.max_merge_angle / kDeg);
@@ -121,6 +125,12 @@ parseSegmentationOptions(int argc, char** argv, SelectiveSegmentationParameters&
       !parseNumber(argc, argv, "-min_split_points", p.min_points_to_split) ||
       !parseNumber(argc, argv, "-max_depth", p.max_octree_depth) ||
       !parseNumber(argc, argv, "-angle_step_rad", p.angle_quantization) ||
+      !parseChoice(argc,
+                   argv,
+                   "-spread_frame",
+                   {{"sensor", NormalSpreadFrame::Sensor},
+                    {"mean_normal", NormalSpreadFrame::MeanNormal}},
+                   p.normal_spread_frame) ||
       !parseChoice(argc,
                    argv,
                    "-edge_normal",

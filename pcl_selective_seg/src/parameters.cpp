@@ -64,6 +64,12 @@ SelectiveSegmentationParameters::validate(std::string* why) const
                   "edge_triangle_normal",
                   static_cast<int>(edge_triangle_normal),
                   "facet or vertex_mean (EdgeTriangleNormal 0 or 1)");
+  if (normal_spread_frame != NormalSpreadFrame::Sensor &&
+      normal_spread_frame != NormalSpreadFrame::MeanNormal)
+    return reject(why,
+                  "normal_spread_frame",
+                  static_cast<int>(normal_spread_frame),
+                  "sensor or mean_normal (NormalSpreadFrame 0 or 1)");
   if (delaunay_backend != DelaunayBackend::BoostVoronoi &&
       delaunay_backend != DelaunayBackend::Vtk &&
       delaunay_backend != DelaunayBackend::Sweep)

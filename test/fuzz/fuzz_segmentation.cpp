@@ -205,11 +205,15 @@ LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size)
     p.num_threads = i32(10) % 4; // valid 0-3 or invalid negatives: no thread storms
     p.edge_triangle_normal =
         static_cast<pcl::selective_seg::EdgeTriangleNormal>(slot[11] & 0xff);
+    p.normal_spread_frame =
+        static_cast<pcl::selective_seg::NormalSpreadFrame>((slot[11] >> 8) & 0xff);
     p.delaunay_backend =
         static_cast<pcl::selective_seg::DelaunayBackend>(slot[12] & 0xff);
   } else {
     p.edge_triangle_normal =
         static_cast<pcl::selective_seg::EdgeTriangleNormal>(slot[11] & 1);
+    p.normal_spread_frame =
+        static_cast<pcl::selective_seg::NormalSpreadFrame>((slot[11] >> 1) & 1);
     if (slot[12] & 1)
       p.delaunay_backend = pcl::selective_seg::DelaunayBackend::BoostVoronoi;
   }

@@ -19,6 +19,7 @@
 
 using pcl::selective_seg::DelaunayBackend;
 using pcl::selective_seg::EdgeTriangleNormal;
+using pcl::selective_seg::NormalSpreadFrame;
 using pcl::selective_seg::SelectiveSegmentationParameters;
 using Params = SelectiveSegmentationParameters;
 
@@ -98,6 +99,13 @@ fields()
        "facet or vertex_mean",
        [](Params& p, double v) {
          p.edge_triangle_normal = static_cast<EdgeTriangleNormal>(static_cast<int>(v));
+       },
+       {2, 7, 255},
+       {0, 1}},
+      {"normal_spread_frame",
+       "sensor or mean_normal",
+       [](Params& p, double v) {
+         p.normal_spread_frame = static_cast<NormalSpreadFrame>(static_cast<int>(v));
        },
        {2, 7, 255},
        {0, 1}},

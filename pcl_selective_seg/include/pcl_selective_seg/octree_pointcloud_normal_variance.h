@@ -8,6 +8,7 @@
 
 #include <pcl_selective_seg/adaptive_leaf.h>
 #include <pcl_selective_seg/octree_normal_variance_container.h>
+#include <pcl_selective_seg/parameters.h>
 
 #include <Eigen/Geometry>
 #include <pcl/octree/octree_pointcloud.h>
@@ -126,6 +127,11 @@ public:
     sensor_orientation_ = orientation;
   }
 
+  /** \brief Frame of eq. 5's normal angles (NormalSpreadFrame). Default: Sensor,
+   * the paper's. */
+  void setNormalSpreadFrame(NormalSpreadFrame frame) { spread_frame_ = frame; }
+  NormalSpreadFrame getNormalSpreadFrame() const { return spread_frame_; }
+
   /** \brief Fit the bounding box to the valid points and insert them. Replaces
    * OctreePointCloud::addPointsFromInputCloud (which ignores normals and grows the
    * box in insertion order). \return false when no point is valid. */
@@ -229,6 +235,7 @@ private:
   NormalVectorsConstPtr normal_vectors_;
   AreasConstPtr areas_;
   Eigen::Quaternionf sensor_orientation_ = Eigen::Quaternionf::Identity();
+  NormalSpreadFrame spread_frame_ = NormalSpreadFrame::Sensor;
   /** The indices of the leaves built by addPointsFromInputCloud(), leaf after leaf;
    * their containers view them. Assigned only while the tree is empty
    * (addPointsAndComputeAdaptiveLeaves() stores them in ordered_indices_). */
@@ -248,7 +255,8 @@ private:
    */
   bool leaves_view_ordered_ = false;
   detail::ScratchVector<Eigen::Vector3d> ordered_normals_; ///< sensor frame, reversed
-  detail::ScratchVector<double> ordered_theta_; ///< angles of ordered_normals_ [rad]
+  /** Sensor-frame angles of ordered_normals_ [rad] (NormalSpreadFrame::Sensor only) */
+  detail::ScratchVector<double> ordered_theta_;
   detail::ScratchVector<double> ordered_phi_;
   detail::ScratchVector<double> ordered_weights_; ///< 1 / A_p (eq. 4)
   std::vector<AdaptiveLeaf> leaves_;

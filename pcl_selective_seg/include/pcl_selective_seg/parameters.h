@@ -24,6 +24,22 @@ enum class EdgeTriangleNormal : std::uint8_t {
   VertexMean = 1
 };
 
+/** \brief The frame in which eq. 5 measures the angles of a voxel's normals. */
+enum class NormalSpreadFrame : std::uint8_t {
+  /** The sensor frame, as in the paper: theta = atan2(m_x, m_z), phi = atan2(m_y,
+   * m_z) of each normal m (turned away from the sensor). Ill-conditioned for normals
+   * nearly perpendicular to the optical axis (a floor seen by a level camera), where
+   * m_z is near 0 and small noise swings the angles across (-pi, pi]. */
+  Sensor = 0,
+  /** The voxel's own frame, whose z axis is its mean normal (eq. 4) and whose x axis
+   * is the sensor's x axis projected onto the voxel's tangent plane (the sensor's y
+   * axis when x is nearly along the mean normal): eq. 5's angles then measure each
+   * normal's tilt away from the mean in two directions of the tangent plane, the
+   * well-conditioned case of a surface seen head-on, whatever the surface's
+   * orientation. Equal to Sensor to first order for a surface facing the sensor. */
+  MeanNormal = 1
+};
+
 /** \brief Every parameter of SelectiveSegmentation, with the paper's defaults.
  *
  * Angles are in radians, lengths in metres (the cloud's unit). docs/parameters.md gives
@@ -33,6 +49,10 @@ struct PCL_EXPORTS SelectiveSegmentationParameters {
   /** \brief Octree split threshold on the weighted standard deviation of the normal
    * angles (eq. 5), per axis [rad]. Paper: 7.6 degrees. Valid: (0, pi]. */
   double max_normal_std_dev = 7.6 * M_PI / 180.0;
+  /** \brief Frame of eq. 5's normal angles. Default: the sensor frame, as in the
+   * paper; MeanNormal removes the ill-conditioning of normals perpendicular to the
+   * optical axis (docs/parameters.md). */
+  NormalSpreadFrame normal_spread_frame = NormalSpreadFrame::Sensor;
 
   /** \brief Maximum angle between two segment normals for them to merge (eq. 9)
    * [rad]. Paper: 25 degrees. Valid: [0, pi]. */

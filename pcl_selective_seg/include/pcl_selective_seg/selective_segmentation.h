@@ -86,6 +86,13 @@ public:
   void setMaxNormalStdDev(double angle) { params_.max_normal_std_dev = angle; }
   double getMaxNormalStdDev() const { return params_.max_normal_std_dev; }
 
+  /** \brief Frame of eq. 5's normal angles; default the sensor frame (the paper). */
+  void setNormalSpreadFrame(NormalSpreadFrame frame)
+  {
+    params_.normal_spread_frame = frame;
+  }
+  NormalSpreadFrame getNormalSpreadFrame() const { return params_.normal_spread_frame; }
+
   /** \brief Largest angle between segment normals that still merge (eq. 9) [rad]. */
   void setMaxMergeAngle(double angle) { params_.max_merge_angle = angle; }
   double getMaxMergeAngle() const { return params_.max_merge_angle; }

@@ -41,6 +41,19 @@ mortonCode(const pcl::octree::OctreeKey& key)
   return (spread(key.x) << 2) | (spread(key.y) << 1) | spread(key.z);
 }
 
+/** \brief Axes u, v of the plane perpendicular to the unit vector \a z, with (u, v, z)
+ * right-handed: u is the sensor's x axis projected onto that plane, or its y axis when
+ * x is within about 25 degrees of \a z (then the projection is too short to be
+ * well-conditioned). NaN in, NaN out. */
+inline void
+tangentAxes(const Eigen::Vector3d& z, Eigen::Vector3d& u, Eigen::Vector3d& v)
+{
+  const Eigen::Vector3d reference =
+      std::abs(z.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+  u = (reference - reference.dot(z) * z).normalized();
+  v = z.cross(u);
+}
+
 /** \brief Angle difference wrapped into (-pi, pi]. */
 inline double
 wrapAngle(double a)
@@ -355,8 +368,10 @@ OctreePointCloudNormalVariance<PointT>::computeNormalAngle(std::size_t k,
   const Eigen::Vector3d m =
       -(to_sensor * inputNormal(i).template cast<double>()).normalized();
   ordered_normals_[k] = m;
-  ordered_theta_[k] = std::atan2(m.x(), m.z());
-  ordered_phi_[k] = std::atan2(m.y(), m.z());
+  if (spread_frame_ == NormalSpreadFrame::Sensor) {
+    ordered_theta_[k] = std::atan2(m.x(), m.z());
+    ordered_phi_[k] = std::atan2(m.y(), m.z());
+  }
   ordered_weights_[k] = 1.0 / (*areas_)[i]; // eq. 4: weight 1 / A_p
 }
 
@@ -388,16 +403,36 @@ OctreePointCloudNormalVariance<PointT>::computeStatistics(std::size_t begin,
     s.sum_weight += w;
   }
   const Eigen::Vector3d mean = s.sum_weighted_normal.normalized();
-  const double theta_v = std::atan2(mean.x(), mean.z());
-  const double phi_v = std::atan2(mean.y(), mean.z());
+  const bool sensor_frame = spread_frame_ == NormalSpreadFrame::Sensor;
+  const double theta_v = sensor_frame ? std::atan2(mean.x(), mean.z()) : 0.0;
+  const double phi_v = sensor_frame ? std::atan2(mean.y(), mean.z()) : 0.0;
+  // NormalSpreadFrame::MeanNormal: the voxel's frame (u, v, mean), in which the mean
+  // normal has the angles (0, 0) of a surface seen head-on.
+  Eigen::Vector3d u = Eigen::Vector3d::Zero(), v = Eigen::Vector3d::Zero();
+  if (!sensor_frame)
+    detail::tangentAxes(mean, u, v);
   double var_theta = 0.0, var_phi = 0.0;
   for (std::size_t k = begin; k < end;) {
-    for (const std::size_t block_end = std::min(end, k + 256); k < block_end; ++k) {
-      const double w = ordered_weights_[k];
-      const double dt = detail::wrapAngle(ordered_theta_[k] - theta_v);
-      const double dp = detail::wrapAngle(ordered_phi_[k] - phi_v);
-      var_theta += w * dt * dt; // eq. 5
-      var_phi += w * dp * dp;
+    const std::size_t block_end = std::min(end, k + 256);
+    if (sensor_frame) {
+      for (; k < block_end; ++k) {
+        const double w = ordered_weights_[k];
+        const double dt = detail::wrapAngle(ordered_theta_[k] - theta_v);
+        const double dp = detail::wrapAngle(ordered_phi_[k] - phi_v);
+        var_theta += w * dt * dt; // eq. 5
+        var_phi += w * dp * dp;
+      }
+    }
+    else {
+      for (; k < block_end; ++k) {
+        const double w = ordered_weights_[k];
+        const Eigen::Vector3d& m = ordered_normals_[k];
+        const double c = m.dot(mean);
+        const double dt = std::atan2(m.dot(u), c); // eq. 5 in the voxel's frame
+        const double dp = std::atan2(m.dot(v), c);
+        var_theta += w * dt * dt;
+        var_phi += w * dp * dp;
+      }
     }
     s.sigma_theta = std::sqrt(var_theta / s.sum_weight);
     s.sigma_phi = std::sqrt(var_phi / s.sum_weight);

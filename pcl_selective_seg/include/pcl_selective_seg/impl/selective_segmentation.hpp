@@ -278,6 +278,7 @@ SelectiveSegmentation<PointT>::buildOctree()
       std::shared_ptr<const Vector3fVector>(), &vertex_normals_);
   octree_->setInputNormals(lent, vertex_areas_);
   octree_->setNumberOfThreads(static_cast<unsigned int>(params_.num_threads));
+  octree_->setNormalSpreadFrame(params_.normal_spread_frame);
   const bool inserted = octree_->addPointsAndComputeAdaptiveLeaves(
       params_.max_normal_std_dev, static_cast<std::size_t>(params_.min_points_to_split));
   octree_->setInputNormals(typename Octree::NormalVectorsConstPtr(), vertex_areas_);
