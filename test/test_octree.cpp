@@ -277,15 +277,31 @@ TEST(OctreePointCloudNormalVariance, SigmaThetaAroundWeightedMeanNormal)
   EXPECT_NEAR(leaf.sigma_phi, 0.0, 1e-6);
 }
 
+namespace {
+
+const std::vector<double> kTiltPhis{-30.0 * kDeg, 0.0, 20.0 * kDeg, 50.0 * kDeg};
+const std::vector<double> kTiltAreas{1.0, 2.0, 2.0, 4.0};
+
+/** Four normals tilted by kTiltPhis about the x axis, with the areas kTiltAreas. */
+Scene
+tiltedInPhi()
+{
+  Scene scene;
+  for (std::size_t k = 0; k < kTiltPhis.size(); ++k)
+    scene.add(Eigen::Vector3f(0.f, 0.1f * k, 1.f),
+              facingNormal(0.0, kTiltPhis[k]),
+              kTiltAreas[k]);
+  return scene;
+}
+
+} // namespace
+
 TEST(OctreePointCloudNormalVariance, SigmaPhiWeightedByInverseArea)
 {
   // phi = -30, 0, 20, 50 degrees with A_p = 1, 2, 2, 4: weights 1, 1/2, 1/2, 1/4.
-  Scene scene;
-  const std::vector<double> phis{-30.0 * kDeg, 0.0, 20.0 * kDeg, 50.0 * kDeg};
-  const std::vector<double> areas{1.0, 2.0, 2.0, 4.0};
-  for (std::size_t k = 0; k < phis.size(); ++k)
-    scene.add(
-        Eigen::Vector3f(0.f, 0.1f * k, 1.f), facingNormal(0.0, phis[k]), areas[k]);
+  const Scene scene = tiltedInPhi();
+  const std::vector<double>& phis = kTiltPhis;
+  const std::vector<double>& areas = kTiltAreas;
   const auto octree = buildOctree(scene, 0.01, M_PI);
   ASSERT_EQ(octree->getAdaptiveLeaves().size(), 1u);
   const AdaptiveLeaf& leaf = octree->getAdaptiveLeaves()[0];
@@ -410,12 +426,7 @@ TEST(OctreePointCloudNormalVariance, MeanNormalFrameMatchesSensorFrameInOnePlane
   // Normals tilted within the y-z plane (theta = 0): both frames measure the same
   // angles, phi - phi_mean, so the hand-computed sigmas of
   // SigmaPhiWeightedByInverseArea hold in the voxel's frame too.
-  Scene scene;
-  const std::vector<double> phis{-30.0 * kDeg, 0.0, 20.0 * kDeg, 50.0 * kDeg};
-  const std::vector<double> areas{1.0, 2.0, 2.0, 4.0};
-  for (std::size_t k = 0; k < phis.size(); ++k)
-    scene.add(
-        Eigen::Vector3f(0.f, 0.1f * k, 1.f), facingNormal(0.0, phis[k]), areas[k]);
+  const Scene scene = tiltedInPhi();
   const auto sensor_frame = buildOctree(scene, 0.01, M_PI);
   const auto mean_frame = buildInMeanNormalFrame(scene, 0.01, M_PI);
   ASSERT_EQ(mean_frame->getAdaptiveLeaves().size(), 1u);
