@@ -274,6 +274,55 @@ TEST(SelectiveSegmentation, WallFacingTheSensorIsOneSegment)
   EXPECT_EQ(labeled->height, 40u);
 }
 
+TEST(SelectiveSegmentation, FloorSeenByALevelCameraInTheVoxelFrame)
+{
+  // A floor 1 m below a level camera (y down), x in [-1, 1], z in [1, 4], jittered
+  // by 1 mm in height: its normals are nearly perpendicular to the optical axis, where
+  // eq. 5's sensor-frame angles are ill-conditioned (docs/parameters.md).
+  auto floor = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  std::mt19937 rng(3);
+  std::normal_distribution<float> jitter(0.f, 0.001f);
+  for (int i = 0; i < 100; ++i)
+    for (int j = 0; j < 100; ++j)
+      floor->push_back(pcl::PointXYZ(
+          -1.f + 0.02f * static_cast<float>(i), 1.f + jitter(rng), 1.f + 0.03f * j));
+
+  SelectiveSegmentation<pcl::PointXYZ> paper, voxel_frame;
+  voxel_frame.setNormalSpreadFrame(pcl::selective_seg::NormalSpreadFrame::MeanNormal);
+  std::vector<pcl::PointIndices> cp, cv;
+  ASSERT_TRUE(segment<pcl::PointXYZ>(floor, paper, cp));
+  ASSERT_TRUE(segment<pcl::PointXYZ>(floor, voxel_frame, cv));
+  const std::size_t leaves_paper = paper.getResult().leaves.size();
+  const std::size_t leaves_voxel = voxel_frame.getResult().leaves.size();
+  EXPECT_LT(2 * leaves_voxel, leaves_paper)
+      << leaves_voxel << " leaves against " << leaves_paper;
+  // The leaves' own normals stay those of a floor: every leaf of 50 points or more is
+  // within 7.6 deg of vertical (the split threshold). (The segments are another
+  // matter: docs/parameters.md.)
+  std::size_t large = 0;
+  for (const auto& leaf : voxel_frame.getResult().leaves)
+    if (leaf.num_points >= 50) {
+      ++large;
+      EXPECT_GT(-leaf.normal.y(), std::cos(7.6 * M_PI / 180.0));
+    }
+  EXPECT_GT(large, 10u);
+
+  // Point order does not matter in this frame either.
+  std::vector<int> perm(floor->size());
+  std::iota(perm.begin(), perm.end(), 0);
+  std::shuffle(perm.begin(), perm.end(), std::mt19937(11));
+  auto shuffled = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  for (const int i : perm)
+    shuffled->push_back((*floor)[i]);
+  SelectiveSegmentation<pcl::PointXYZ> again;
+  again.setNormalSpreadFrame(pcl::selective_seg::NormalSpreadFrame::MeanNormal);
+  std::vector<pcl::PointIndices> ca;
+  ASSERT_TRUE(segment<pcl::PointXYZ>(shuffled, again, ca));
+  ASSERT_EQ(again.getResult().leaves.size(), leaves_voxel);
+  for (std::size_t k = 0; k < perm.size(); ++k)
+    ASSERT_EQ(voxel_frame.getResult().labels[perm[k]], again.getResult().labels[k]) << k;
+}
+
 TEST(SelectiveSegmentation, SensorPoseIsHonoured)
 {
   const auto cloud = cubeScene(5432, 5);
