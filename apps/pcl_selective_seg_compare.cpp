@@ -211,12 +211,15 @@ methods()
   robust3.normal_rings = 3;
   SelectiveSegmentationParameters mean_frame = defaults;
   mean_frame.normal_spread_frame = pcl::selective_seg::NormalSpreadFrame::MeanNormal;
+  SelectiveSegmentationParameters area_weight = defaults;
+  area_weight.segment_normal_weight = pcl::selective_seg::SegmentNormalWeight::Area;
   const auto selective = [](const SelectiveSegmentationParameters& p) {
     return [p](const Cloud::ConstPtr& c) { return runSelective(c, p); };
   };
   return {{"selective (paper)", selective(paper)},
           {"selective (default)", selective(defaults)},
           {"selective (eq. 5 in the voxel's frame)", selective(mean_frame)},
+          {"selective (eq. 7 weighted by area)", selective(area_weight)},
           {"selective (rings 3)", selective(rings3)},
           {"selective (rings 2, vertex-mean eq. 8)", selective(robust2)},
           {"selective (rings 3, vertex-mean eq. 8)", selective(robust3)},

@@ -306,6 +306,23 @@ TEST(MergeSeedSegments, SegmentNormalIsInverseAreaWeightedMean)
   EXPECT_NEAR(angleDeg(m.segment_normals[0], tilted(0.0)), 3.961, 1e-2);
 }
 
+TEST(MergeSeedSegments, SegmentNormalWeightedByAreaWhenAsked)
+{
+  // The seeds of SegmentNormalIsInverseAreaWeightedMean with SegmentNormalWeight::Area:
+  // N' = (0, 0, -1) x 1 + (sin 20, 0, -cos 20) x 4 = (1.3680806, 0, -4.7587705),
+  // 16.04 degrees from the first seed.
+  const Strip strip({0, 0, 1, 1}, {0.0, 20.0}, {1.0, 4.0});
+  MergeInput in = strip.input();
+  in.segment_normal_weight = pcl::selective_seg::SegmentNormalWeight::Area;
+  const Merged m = merge(in);
+  EXPECT_EQ(m.leaf_segment, (Segments{0, 0}));
+  ASSERT_EQ(m.segment_normals.size(), 1u);
+  const Eigen::Vector3f expected =
+      Eigen::Vector3f(1.3680806f, 0.0f, -4.7587705f).normalized();
+  EXPECT_NEAR((m.segment_normals[0] - expected).norm(), 0.f, 1e-5f);
+  EXPECT_NEAR(angleDeg(m.segment_normals[0], tilted(0.0)), 16.04, 1e-2);
+}
+
 TEST(MergeSeedSegments, RunningSegmentNormal)
 {
   // A chain of seeds at 0, 15, 30 and 45 degrees, equal areas; the first is the

@@ -306,6 +306,20 @@ TEST(SelectiveSegmentation, FloorSeenByALevelCameraInTheVoxelFrame)
       EXPECT_GT(-leaf.normal.y(), std::cos(7.6 * M_PI / 180.0));
     }
   EXPECT_GT(large, 10u);
+  // The segments: with eq. 7's 1 / A_v the small leaves on the floor's side borders
+  // (normals from the sliver triangles there) steer the segment normal away from the
+  // few large floor leaves, and the floor breaks up; weighted by area, the floor is
+  // one segment again (docs/parameters.md).
+  ASSERT_FALSE(cv.empty());
+  EXPECT_LT(cv[0].indices.size(), floor->size() * 80 / 100);
+  SelectiveSegmentation<pcl::PointXYZ> by_area;
+  by_area.setNormalSpreadFrame(pcl::selective_seg::NormalSpreadFrame::MeanNormal);
+  by_area.setSegmentNormalWeight(pcl::selective_seg::SegmentNormalWeight::Area);
+  std::vector<pcl::PointIndices> cw;
+  ASSERT_TRUE(segment<pcl::PointXYZ>(floor, by_area, cw));
+  ASSERT_FALSE(cw.empty());
+  EXPECT_GE(cw[0].indices.size(), floor->size() * 90 / 100);
+  EXPECT_GT(-by_area.getResult().segments[0].normal.y(), std::cos(M_PI / 180.0));
 
   // Point order does not matter in this frame either.
   std::vector<int> perm(floor->size());

@@ -14,6 +14,7 @@ using pcl::console::print_info;
 using pcl::selective_seg::DelaunayBackend;
 using pcl::selective_seg::EdgeTriangleNormal;
 using pcl::selective_seg::NormalSpreadFrame;
+using pcl::selective_seg::SegmentNormalWeight;
 using pcl::selective_seg::SelectiveSegmentationParameters;
 
 constexpr double kDeg = M_PI / 180.0;
@@ -57,6 +58,7 @@ segmentationFlags()
   static const std::vector<std::string> flags = {"-split_deg",
                                                  "-spread_frame",
                                                  "-merge_deg",
+                                                 "-segment_weight",
                                                  "-edge_deg",
                                                  "-incidence_deg",
                                                  "-normal_rings",
@@ -84,6 +86,8 @@ printSegmentationHelp()
   print_info("  -merge_deg X           max angle between merged segment normals [deg] "
              "(default %g)\n",
              d.max_merge_angle / kDeg);
+  print_info("  -segment_weight NAME   weight of a leaf normal in its segment's (eq. 7): "
+             "inverse_area (paper) or area (default inverse_area)\n");
   print_info("  -edge_deg X            max angle between a valid edge triangle and the "
              "segment [deg] (default %g)\n",
              d.max_edge_triangle_angle / kDeg);
@@ -125,6 +129,12 @@ parseSegmentationOptions(int argc, char** argv, SelectiveSegmentationParameters&
       !parseNumber(argc, argv, "-min_split_points", p.min_points_to_split) ||
       !parseNumber(argc, argv, "-max_depth", p.max_octree_depth) ||
       !parseNumber(argc, argv, "-angle_step_rad", p.angle_quantization) ||
+      !parseChoice(argc,
+                   argv,
+                   "-segment_weight",
+                   {{"inverse_area", SegmentNormalWeight::InverseArea},
+                    {"area", SegmentNormalWeight::Area}},
+                   p.segment_normal_weight) ||
       !parseChoice(argc,
                    argv,
                    "-spread_frame",

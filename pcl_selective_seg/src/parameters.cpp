@@ -64,6 +64,12 @@ SelectiveSegmentationParameters::validate(std::string* why) const
                   "edge_triangle_normal",
                   static_cast<int>(edge_triangle_normal),
                   "facet or vertex_mean (EdgeTriangleNormal 0 or 1)");
+  if (segment_normal_weight != SegmentNormalWeight::InverseArea &&
+      segment_normal_weight != SegmentNormalWeight::Area)
+    return reject(why,
+                  "segment_normal_weight",
+                  static_cast<int>(segment_normal_weight),
+                  "inverse_area or area (SegmentNormalWeight 0 or 1)");
   if (normal_spread_frame != NormalSpreadFrame::Sensor &&
       normal_spread_frame != NormalSpreadFrame::MeanNormal)
     return reject(why,

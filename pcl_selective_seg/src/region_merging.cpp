@@ -90,13 +90,23 @@ leafArea(const MergeInput& in, pcl::index_t l)
 
 /** A segment while it grows: eq. 7 as a running sum. */
 struct GrowingSegment {
+  explicit GrowingSegment(SegmentNormalWeight weight)
+  : by_area(weight == SegmentNormalWeight::Area)
+  {
+  }
+
+  bool by_area; ///< weight A_v instead of the paper's 1 / A_v
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();
 
   void add(const Eigen::Vector3f& leaf_normal, double leaf_area)
   {
-    if (leaf_area > 0.0 && std::isfinite(leaf_area))
-      sum += leaf_normal.cast<double>() / leaf_area;
+    if (leaf_area > 0.0 && std::isfinite(leaf_area)) {
+      if (by_area)
+        sum += leaf_normal.cast<double>() * leaf_area;
+      else
+        sum += leaf_normal.cast<double>() / leaf_area;
+    }
     const double norm = sum.norm();
     if (norm > 0.0 && std::isfinite(norm))
       normal = sum / norm;
@@ -244,7 +254,7 @@ public:
   Eigen::Vector3d
   grow(pcl::index_t seed, State& state)
   {
-    GrowingSegment segment;
+    GrowingSegment segment(in_.segment_normal_weight);
     segment.add(leafNormal(in_, seed), leafArea(in_, seed));
     state.claim(seed);
     queue_.assign(1, seed);

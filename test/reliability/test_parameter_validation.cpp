@@ -20,6 +20,7 @@
 using pcl::selective_seg::DelaunayBackend;
 using pcl::selective_seg::EdgeTriangleNormal;
 using pcl::selective_seg::NormalSpreadFrame;
+using pcl::selective_seg::SegmentNormalWeight;
 using pcl::selective_seg::SelectiveSegmentationParameters;
 using Params = SelectiveSegmentationParameters;
 
@@ -99,6 +100,14 @@ fields()
        "facet or vertex_mean",
        [](Params& p, double v) {
          p.edge_triangle_normal = static_cast<EdgeTriangleNormal>(static_cast<int>(v));
+       },
+       {2, 7, 255},
+       {0, 1}},
+      {"segment_normal_weight",
+       "inverse_area or area",
+       [](Params& p, double v) {
+         p.segment_normal_weight =
+             static_cast<SegmentNormalWeight>(static_cast<int>(v));
        },
        {2, 7, 255},
        {0, 1}},

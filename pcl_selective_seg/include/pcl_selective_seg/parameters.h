@@ -40,6 +40,15 @@ enum class NormalSpreadFrame : std::uint8_t {
   MeanNormal = 1
 };
 
+/** \brief How eq. 7 weights the normals of the leaves that make up a segment. */
+enum class SegmentNormalWeight : std::uint8_t {
+  /** 1 / A_v, as in the paper: a small leaf counts for more than a large one. */
+  InverseArea = 0,
+  /** A_v: the segment normal is the area-weighted mean of its leaves' normals, the
+   * mean normal of the surface they cover, which large, homogeneous leaves dominate. */
+  Area = 1
+};
+
 /** \brief Every parameter of SelectiveSegmentation, with the paper's defaults.
  *
  * Angles are in radians, lengths in metres (the cloud's unit). docs/parameters.md gives
@@ -57,6 +66,9 @@ struct PCL_EXPORTS SelectiveSegmentationParameters {
   /** \brief Maximum angle between two segment normals for them to merge (eq. 9)
    * [rad]. Paper: 25 degrees. Valid: [0, pi]. */
   double max_merge_angle = 25.0 * M_PI / 180.0;
+  /** \brief Weight of a leaf's normal in its segment's normal (eq. 7). Default:
+   * 1 / A_v, as in the paper (docs/parameters.md). */
+  SegmentNormalWeight segment_normal_weight = SegmentNormalWeight::InverseArea;
 
   /** \brief Maximum angle between an edge triangle's normal and the growing segment's
    * normal for the triangle to be searched for neighbours (eq. 8) [rad]. Paper: 25

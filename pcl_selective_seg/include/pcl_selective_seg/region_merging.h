@@ -8,6 +8,7 @@
 
 #include <pcl_selective_seg/adaptive_leaf.h>
 #include <pcl_selective_seg/mesh_normals.h>
+#include <pcl_selective_seg/parameters.h>
 #include <pcl_selective_seg/segmentation_result.h>
 
 #include <pcl/PointIndices.h>
@@ -34,6 +35,8 @@ struct MergeInput {
    */
   const std::vector<std::uint8_t>* triangle_edge_on = nullptr;
   double max_merge_angle = 0.0;         ///< eq. 9 threshold [rad]
+  /** Weight of a leaf's normal in eq. 7: 1 / A_v (the paper) or A_v. */
+  SegmentNormalWeight segment_normal_weight = SegmentNormalWeight::InverseArea;
   double max_edge_triangle_angle = 0.0; ///< eq. 8 threshold [rad]
   /** Threads for building the incidence lists and for growing seeds ahead of their
    * turn (0: all cores). The result does not depend on it. */

@@ -93,6 +93,17 @@ public:
   }
   NormalSpreadFrame getNormalSpreadFrame() const { return params_.normal_spread_frame; }
 
+  /** \brief Weight of a leaf's normal in its segment's normal (eq. 7); default
+   * 1 / A_v (the paper). */
+  void setSegmentNormalWeight(SegmentNormalWeight weight)
+  {
+    params_.segment_normal_weight = weight;
+  }
+  SegmentNormalWeight getSegmentNormalWeight() const
+  {
+    return params_.segment_normal_weight;
+  }
+
   /** \brief Largest angle between segment normals that still merge (eq. 9) [rad]. */
   void setMaxMergeAngle(double angle) { params_.max_merge_angle = angle; }
   double getMaxMergeAngle() const { return params_.max_merge_angle; }

@@ -470,6 +470,7 @@ SelectiveSegmentation<PointT>::mergeAndLabel()
   in.triangle_normals = &edgeTestNormals();
   in.triangle_edge_on = &triangle_edge_on_;
   in.max_merge_angle = params_.max_merge_angle;
+  in.segment_normal_weight = params_.segment_normal_weight;
   in.max_edge_triangle_angle = params_.max_edge_triangle_angle;
   in.num_threads = numThreads();
   std::vector<pcl::index_t> leaf_segment;
