@@ -345,8 +345,10 @@ void
 OctreePointCloudNormalVariance<PointT>::resizeScratch(std::size_t n)
 {
   ordered_normals_.resize(n);
-  ordered_theta_.resize(n);
-  ordered_phi_.resize(n);
+  // The sensor-frame angles are read only in that frame (computeStatistics()).
+  const std::size_t angles = spread_frame_ == NormalSpreadFrame::Sensor ? n : 0;
+  ordered_theta_.resize(angles);
+  ordered_phi_.resize(angles);
   ordered_weights_.resize(n);
 }
 
