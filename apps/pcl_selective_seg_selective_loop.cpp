@@ -74,6 +74,7 @@ fineStep(const std::string& scene)
 void
 printHelp(const char* program)
 {
+  const Options defaults; // the help shows the values the tool starts from
   print_info(
       "The simulated coarse-to-fine loop of selective sensing against uniform "
       "scans.\n\n"
@@ -81,27 +82,35 @@ printHelp(const char* program)
       "  -out FOLDER            where table.md, <scene>.dat, clouds and windows go "
       "(made if missing)\n"
       "  -scenes a,b            scenes among cube, chair, door (default all three)\n"
-      "  -iterations N          refinement rounds (default 3)\n"
-      "  -coarse_factor X       coarse step = X times the fine step (default 3)\n"
+      "  -iterations N          refinement rounds (default %d)\n"
+      "  -coarse_factor X       coarse step = X times the fine step (default %g)\n"
       "  -budget_fraction F     selective point budget, fraction of the finest uniform "
-      "scan's points (default 0.3)\n"
-      "  -range_noise K         range noise sigma = K r^2 [1/m] (default 0.0005, "
+      "scan's points (default %g)\n"
+      "  -range_noise K         range noise sigma = K r^2 [1/m] (default %g, "
       "level A)\n"
       "  -min_voxel_factor X    finest voxel = X fine steps at the median range; 0 = "
-      "automatic from the coarse scan (default 2)\n"
+      "automatic from the coarse scan (default %g)\n"
       "  -progressive 0|1       1: each round a step finer, the last at the fine "
-      "step; 0: every round at the fine step (default 1)\n"
+      "step; 0: every round at the fine step (default %g)\n"
       "  -window_steps X        evidence tiles of X coarse steps; 0 = "
-      "-roi_max_window_deg (default 2)\n"
+      "-roi_max_window_deg (default %g)\n"
       "  -step_scale S          multiply every step by S (S > 1: a quicker, coarser "
-      "run; default 1)\n"
+      "run; default %g)\n"
       "  -seed N                the sensor's random seed (rays, dropouts, noise) for "
       "every scan; default: the scene's own\n\n"
       "The loop sets the regions' step (the fine step), point budget and yield; the "
       "other\nregion options apply (the budget flags are ignored). The loop's own "
       "defaults differ from those\nlisted below: -roi_margin_spacings 0.5 "
       "-roi_valid_edges 1 -roi_edge_on 1 -roi_side_deg 25 -roi_sparse_by_area 1:\n",
-      program);
+      program,
+      defaults.iterations,
+      defaults.coarse_factor,
+      defaults.budget_fraction,
+      defaults.range_noise,
+      defaults.min_voxel_factor,
+      defaults.progressive,
+      defaults.window_steps,
+      defaults.step_scale);
   selseg_apps::printRegionHelp();
   print_info("Segmentation (both strategies):\n");
   selseg_apps::printSegmentationHelp();

@@ -24,6 +24,15 @@ function(expect code pattern)
 endfunction()
 
 expect(0 "" -h)
+# The help states the defaults the tool starts from (it once said tiles of 2 coarse
+# steps while the tool used 1).
+execute_process(COMMAND ${LOOP} -h OUTPUT_VARIABLE help ERROR_VARIABLE help_err)
+foreach(line "-window_steps X[^\n]*\\(default 1\\)" "-iterations N[^\n]*\\(default 3\\)"
+             "-coarse_factor X[^\n]*\\(default 3\\)")
+  if(NOT "${help}${help_err}" MATCHES "${line}")
+    set(failures "${failures}\n  '-h' does not show '${line}'")
+  endif()
+endforeach()
 expect(2 "")
 expect(2 "Unknown argument '-bogus'" -bogus 1)
 expect(2 "Missing value of '-out'" -out)
