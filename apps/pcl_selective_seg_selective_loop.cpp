@@ -390,6 +390,53 @@ runScene(const Options& opt, const std::string& name, std::string& table)
         1000.0 * outside[0] / static_cast<double>(std::max<std::size_t>(n_out, 1)),
         1000.0 * outside[1] / static_cast<double>(std::max<std::size_t>(n_out, 1)));
   }
+  {
+    // The same by the kind of true edge (metrics::describeBoundaryPoints()): depth
+    // jumps, and creases by the angle between the surfaces, against the merge angle
+    // (25 deg by default) with a margin of 5 deg either side: the segmentation splits
+    // creases well above it, a crease near it by the noise of the normals, and a
+    // border below it (a smooth one has 0) only by noise or by the octree.
+    const double merge_deg = opt.segmentation.max_merge_angle * 180.0 / M_PI;
+    const double lo = merge_deg - 5.0, hi = merge_deg + 5.0;
+    const char* names[5] = {"depth jumps",
+                            "creases > merge + 5 deg",
+                            "creases within 5 deg of merge",
+                            "creases < merge - 5 deg",
+                            "undetermined"};
+    double sum[5][2] = {};
+    std::size_t count[5] = {};
+    for (std::size_t i = 0; i < reference.kinds.size(); ++i) {
+      const auto& k = reference.kinds[i];
+      const double deg = k.crease_angle * 180.0 / M_PI;
+      const int c = k.depth_jump      ? 0
+                    : std::isnan(deg) ? 4
+                    : deg > hi        ? 1
+                    : deg >= lo       ? 2
+                                      : 3;
+      sum[c][0] += uniform.back().reference_distances[i];
+      sum[c][1] += rounds.back().reference_distances[i];
+      ++count[c];
+    }
+    std::string line;
+    for (int c = 0; c < 5; ++c) {
+      char buffer[160];
+      const double n = static_cast<double>(std::max<std::size_t>(count[c], 1));
+      std::snprintf(buffer,
+                    sizeof buffer,
+                    "%s%s %zu, %.2f / %.2f mm",
+                    c ? "; " : "",
+                    names[c],
+                    count[c],
+                    1000.0 * sum[c][0] / n,
+                    1000.0 * sum[c][1] / n);
+      line += buffer;
+    }
+    print_info("%s: true edge points by kind (merge angle %.0f deg), mean distance "
+               "finest uniform / selective: %s\n",
+               name.c_str(),
+               merge_deg,
+               line.c_str());
+  }
   pcl::selective_seg::RegionOfInterestStats all;
   all.selected = scanned.size();
   files_ok = files_ok && selseg_apps::writeRegionsJson(
@@ -397,12 +444,16 @@ runScene(const Options& opt, const std::string& name, std::string& table)
   // Where the error is: every reference boundary point with its distance to the
   // nearest predicted boundary, for the finest uniform scan and the last round.
   std::ofstream errors(base + "_boundary_errors.dat");
-  errors << "# theta phi (rad) distance_dense distance_selective (m)\n";
+  errors << "# theta phi (rad) distance_dense distance_selective (m) depth_jump "
+            "crease_angle (deg, nan: undetermined) in_window (0/1)\n";
   for (std::size_t i = 0; i < reference.points.size(); ++i) {
     const auto& p = reference.points[i];
     errors << std::atan2(p.x, p.z) << " " << std::atan2(p.y, p.z) << " "
            << uniform.back().reference_distances[i] << " "
-           << rounds.back().reference_distances[i] << "\n";
+           << rounds.back().reference_distances[i] << " "
+           << (reference.kinds[i].depth_jump ? 1 : 0) << " "
+           << reference.kinds[i].crease_angle * 180.0 / M_PI << " "
+           << (truth_covered[i] ? 1 : 0) << "\n";
   }
   errors.close();
   files_ok = files_ok && static_cast<bool>(errors);

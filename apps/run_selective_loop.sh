@@ -44,6 +44,34 @@ awk -F'|' 'NR > 2 && NF > 3 {gsub(/ /, "", $2); n[$2]++; r[$2] += $6} END {for (
   "$out/seeds.md" | sort >> "$out/seeds.md"
 cat "$out/seeds.md"
 
+# Where the gap is, by the kind of true edge (the last columns of
+# <scene>_boundary_errors.dat: depth jump, crease angle, inside a scanned window),
+# pooled over the eight draws: OUT/kinds.md.
+{
+  echo "| scene | true edge | points (share) | inside a window | finest uniform (mm) | selective (mm) | ratio | share of the gap |"
+  echo "|---|---|---|---|---|---|---|---|"
+  for scene in cube chair door; do
+    cat "$out/${scene}_boundary_errors.dat" "$out"/seed_*/"${scene}_boundary_errors.dat" |
+      awk -v scene="$scene" '
+        !/^#/ && NF >= 7 {
+          if ($5 == 1) k = "1 depth jump"
+          else if ($6 ~ /nan/) k = "5 undetermined"
+          else if ($6 + 0 > 30) k = "2 crease > 30 deg"
+          else if ($6 + 0 >= 20) k = "3 crease 20-30 deg"
+          else k = "4 crease < 20 deg"
+          n[k]++; w[k] += $7; u[k] += $3; s[k] += $4; N++; U += $3; S += $4
+        }
+        END {
+          for (k in n)
+            printf "%s|| %s | %s | %d (%.1f%%) | %.0f%% | %.2f | %.2f | %.2f | %s |\n",
+              k, scene, substr(k, 3), n[k], 100 * n[k] / N, 100 * w[k] / n[k],
+              1000 * u[k] / n[k], 1000 * s[k] / n[k], s[k] / u[k],
+              (S > U ? sprintf("%.0f%%", 100 * (s[k] - u[k]) / (S - U)) : "-")
+        }' | sort | sed 's/^[^|]*||/|/'
+  done
+} > "$out/kinds.md"
+cat "$out/kinds.md"
+
 # Boundary accuracy against points acquired, one panel per scene.
 gnuplot <<GNUPLOT
 set terminal pngcairo size 1500,480 font ",11"

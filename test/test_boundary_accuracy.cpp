@@ -135,3 +135,160 @@ TEST(BoundaryDistances, EmptySetsGiveNaN)
   EXPECT_EQ(d.num_from, 0u);
   EXPECT_TRUE(std::isnan(d.median));
 }
+
+namespace {
+
+/** A 5 x 3 grid in x (-0.2 .. 0.2) and y (0 .. 0.2) seen from the origin: columns with
+ * x <= 0 carry label 1 and lie on z = 2 + x tan(a), the others label 2 on
+ * z = 2 - x tan(b) (both meet at x = 0); with a jump_scale > 0, label 2 lies on z = 2
+ * instead and every point of it is moved along its ray to jump_scale times its range.
+ * Each grid cell gives two triangles. */
+struct Grid {
+  Cloud cloud;
+  Triangles triangles;
+  std::vector<std::uint32_t> labels;
+};
+
+Grid
+twoFaces(double a, double b, double jump_scale = 0.0)
+{
+  Grid g;
+  for (int i = 0; i < 5; ++i)
+    for (int j = 0; j < 3; ++j) {
+      const double x = 0.1 * (i - 2);
+      const double z = x <= 0.0         ? 2.0 + x * std::tan(a)
+                       : jump_scale > 0 ? 2.0
+                                        : 2.0 - x * std::tan(b);
+      const double s = x > 0.0 && jump_scale > 0 ? jump_scale : 1.0;
+      g.cloud.push_back(pcl::PointXYZ(static_cast<float>(s * x),
+                                      static_cast<float>(s * 0.1 * j),
+                                      static_cast<float>(s * z)));
+      g.labels.push_back(x <= 0.0 ? 1u : 2u);
+    }
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 2; ++j) {
+      const pcl::index_t v = 3 * i + j;
+      g.triangles.push_back({v, v + 3, v + 1});
+      g.triangles.push_back({v + 1, v + 3, v + 4});
+    }
+  return g;
+}
+
+std::vector<metrics::BoundaryEdgeKind>
+describe(const Grid& g, pcl::Indices* boundary_out = nullptr)
+{
+  pcl::Indices boundary;
+  EXPECT_TRUE(metrics::labelBoundaryPoints(
+      g.cloud, g.triangles, g.labels, Eigen::Vector3f::Zero(), M_PI, boundary));
+  std::vector<metrics::BoundaryEdgeKind> kinds;
+  EXPECT_TRUE(metrics::describeBoundaryPoints(g.cloud,
+                                              g.triangles,
+                                              g.labels,
+                                              Eigen::Vector3f::Zero(),
+                                              M_PI,
+                                              85.0 * M_PI / 180.0,
+                                              boundary,
+                                              kinds));
+  EXPECT_EQ(kinds.size(), boundary.size());
+  if (boundary_out)
+    *boundary_out = boundary;
+  return kinds;
+}
+
+} // namespace
+
+TEST(DescribeBoundaryPoints, CreaseAngleIsTheAngleBetweenTheFaces)
+{
+  // Faces tilted by 45 deg each way: a 90 deg crease (a box's edge seen from inside).
+  // The boundary points are the nearer ends of the edges x = 0 -> x = 0.1: the
+  // column x = 0.1 (z = 1.9 < 2).
+  pcl::Indices boundary;
+  auto kinds = describe(twoFaces(M_PI / 4, M_PI / 4), &boundary);
+  ASSERT_EQ(boundary, (pcl::Indices{9, 10, 11}));
+  for (const auto& k : kinds) {
+    EXPECT_FALSE(k.depth_jump);
+    EXPECT_NEAR(k.crease_angle, M_PI / 2, 1e-5);
+  }
+  // Degenerate triangles (a corner repeated) add no side normal: the same angles.
+  Grid with_degenerate = twoFaces(M_PI / 4, M_PI / 4);
+  with_degenerate.triangles.push_back({9, 9, 12});
+  with_degenerate.triangles.push_back({6, 9, 9});
+  for (const auto& k : describe(with_degenerate))
+    EXPECT_NEAR(k.crease_angle, M_PI / 2, 1e-5);
+  // 10 and 15 deg tilts: a 25 deg crease, the merge angle.
+  for (const auto& k : describe(twoFaces(10.0 * M_PI / 180, 15.0 * M_PI / 180))) {
+    EXPECT_FALSE(k.depth_jump);
+    EXPECT_NEAR(k.crease_angle, 25.0 * M_PI / 180, 1e-5);
+  }
+  // One plane, two labels: a smooth border, angle 0 (a float's worth of rounding).
+  for (const auto& k : describe(twoFaces(0.3, -0.3))) {
+    EXPECT_FALSE(k.depth_jump);
+    EXPECT_NEAR(k.crease_angle, 0.0, 1e-6);
+  }
+}
+
+TEST(DescribeBoundaryPoints, DepthJumpsAreEdgesAlongTheLineOfSight)
+{
+  // Label 2 pushed back along its rays to three times its range: every edge across
+  // the border runs within about 2 deg of its line of sight (the lateral step of 0.1
+  // or 0.14 m against 4 m of depth), inside 90 - 85 deg: depth jumps, at the nearer
+  // column x = 0.
+  pcl::Indices boundary;
+  const auto kinds = describe(twoFaces(0.0, 0.0, 3.0), &boundary);
+  ASSERT_EQ(boundary, (pcl::Indices{6, 7, 8}));
+  for (const auto& k : kinds) {
+    EXPECT_TRUE(k.depth_jump);
+    EXPECT_TRUE(std::isnan(k.crease_angle)); // no crease edge at these points
+  }
+  // Pushed back by 10% only (0.2 m of depth against the same lateral step: edges 25
+  // deg or more from their line of sight): no jump; the two sides are parallel planes.
+  for (const auto& k : describe(twoFaces(0.0, 0.0, 1.1))) {
+    EXPECT_FALSE(k.depth_jump);
+    EXPECT_NEAR(k.crease_angle, 0.0, 1e-6);
+  }
+}
+
+TEST(DescribeBoundaryPoints, NoSideOfItsOwnGivesNaN)
+{
+  // Labels alternating by column: no triangle has one label at all three corners.
+  Grid g = twoFaces(0.0, 0.0);
+  for (std::size_t i = 0; i < g.labels.size(); ++i)
+    g.labels[i] = 1 + static_cast<std::uint32_t>((i / 3) % 2);
+  const auto kinds = describe(g);
+  ASSERT_FALSE(kinds.empty());
+  for (const auto& k : kinds) {
+    EXPECT_FALSE(k.depth_jump);
+    EXPECT_TRUE(std::isnan(k.crease_angle));
+  }
+}
+
+TEST(DescribeBoundaryPoints, BadInput)
+{
+  const Grid g = twoFaces(0.0, 0.0);
+  std::vector<metrics::BoundaryEdgeKind> kinds(1);
+  EXPECT_FALSE(metrics::describeBoundaryPoints(
+      g.cloud, g.triangles, g.labels, Eigen::Vector3f::Zero(), M_PI, 0.0, {}, kinds));
+  EXPECT_TRUE(kinds.empty());
+  EXPECT_FALSE(metrics::describeBoundaryPoints(g.cloud,
+                                               g.triangles,
+                                               g.labels,
+                                               Eigen::Vector3f::Zero(),
+                                               M_PI,
+                                               1.0,
+                                               {static_cast<pcl::index_t>(15)},
+                                               kinds));
+  EXPECT_FALSE(metrics::describeBoundaryPoints(
+      g.cloud, g.triangles, {1u, 2u}, Eigen::Vector3f::Zero(), M_PI, 1.0, {}, kinds));
+  // A boundary point listed by the caller but with no boundary edge: default kind.
+  ASSERT_TRUE(metrics::describeBoundaryPoints(g.cloud,
+                                              g.triangles,
+                                              g.labels,
+                                              Eigen::Vector3f::Zero(),
+                                              M_PI,
+                                              1.0,
+                                              {static_cast<pcl::index_t>(0)},
+                                              kinds));
+  ASSERT_EQ(kinds.size(), 1u);
+  EXPECT_FALSE(kinds[0].depth_jump);
+  EXPECT_TRUE(std::isnan(kinds[0].crease_angle));
+}

@@ -176,3 +176,40 @@ TEST(SelectiveLoop, DepthJumpsInsideASegmentAreRefined)
   EXPECT_LT(with.back().accuracy.mean, 0.5 * without.back().accuracy.mean);
   EXPECT_LT(with.back().accuracy.p90, 0.5 * without.back().accuracy.p90);
 }
+
+TEST(SelectiveLoop, ReferenceBoundaryTellsJumpsAndCreasesApart)
+{
+  // The cube scene: box faces, table and wall meet at right angles, and the box and
+  // the table occlude the wall: depth jumps and 90 deg creases only.
+  sim::ReferenceBoundary cube_reference;
+  ASSERT_TRUE(sim::makeReferenceBoundary(cube(), 0.003, cube_reference));
+  ASSERT_EQ(cube_reference.kinds.size(), cube_reference.points.size());
+  std::size_t jumps = 0, right = 0, other = 0;
+  for (const auto& k : cube_reference.kinds)
+    if (k.depth_jump)
+      ++jumps;
+    else if (!std::isnan(k.crease_angle))
+      ++(std::abs(k.crease_angle * 180.0 / M_PI - 90.0) < 1.5 ? right : other);
+  EXPECT_GT(jumps, 100u);
+  EXPECT_GT(right, 500u);
+  EXPECT_EQ(other, 0u);
+
+  // The door (docs/selective_sensing.md): the panel, the shoulder and the ding are one
+  // smooth skin (borders of 0 deg, measured up to about 10 deg where the one-ring
+  // side normals see the skin's curvature), the skin meets the window frame in a
+  // crease of 25 deg (measured 25-30 deg), and the frame's edges are depth jumps.
+  const auto door = sim::makeDoorScene();
+  sim::ReferenceBoundary door_reference;
+  ASSERT_TRUE(sim::makeReferenceBoundary(door, 0.0016, door_reference));
+  ASSERT_EQ(door_reference.kinds.size(), door_reference.points.size());
+  std::size_t door_jumps = 0, smooth = 0, crease25 = 0;
+  for (const auto& k : door_reference.kinds) {
+    const double deg = k.crease_angle * 180.0 / M_PI;
+    door_jumps += k.depth_jump;
+    smooth += !k.depth_jump && deg < 12.0;
+    crease25 += !k.depth_jump && deg >= 24.0 && deg < 31.0;
+  }
+  EXPECT_GT(door_jumps, door_reference.points.size() / 2);
+  EXPECT_GT(smooth, 300u);
+  EXPECT_GT(crease25, 200u);
+}

@@ -23,13 +23,13 @@ const std::vector<std::string>&
 regionFlags()
 {
   static const std::vector<std::string> flags = {
-      "-roi_max_sr",          "-roi_max_points",     "-roi_max_regions",
-      "-roi_yield",           "-roi_step_deg",       "-roi_refine",
-      "-roi_max_window_deg",  "-roi_min_window_deg", "-roi_margin_deg",
-      "-roi_margin_spacings", "-roi_small_points",   "-roi_min_component",
-      "-roi_valid_edges",     "-roi_sparse_factor",  "-roi_leaf_sigma_deg",
-      "-roi_side_deg",        "-roi_edge_on_deg",    "-roi_edge_on",
-      "-roi_sparse_by_area",  "-roi_weights"};
+      "-roi_max_sr",         "-roi_max_points",      "-roi_max_regions",
+      "-roi_yield",          "-roi_step_deg",        "-roi_refine",
+      "-roi_min_refinement", "-roi_max_window_deg",  "-roi_min_window_deg",
+      "-roi_margin_deg",     "-roi_margin_spacings", "-roi_small_points",
+      "-roi_min_component",  "-roi_valid_edges",     "-roi_sparse_factor",
+      "-roi_leaf_sigma_deg", "-roi_side_deg",        "-roi_edge_on_deg",
+      "-roi_edge_on",        "-roi_sparse_by_area",  "-roi_weights"};
   return flags;
 }
 
@@ -50,6 +50,9 @@ printRegionHelp()
       "spacing / -roi_refine (default %g)\n"
       "  -roi_refine X            refinement of the step when -roi_step_deg is 0 "
       "(default %g)\n"
+      "  -roi_min_refinement X    windows (and, with -roi_step_deg, evidence) "
+      "sampled within X times the\n"
+      "                           suggested step already are left out (default %g)\n"
       "  -roi_max_window_deg X    largest window side (default %g)\n"
       "  -roi_min_window_deg X    smallest window side (default %g)\n"
       "  -roi_margin_deg X        margin around the evidence (default %g)\n"
@@ -85,6 +88,7 @@ printRegionHelp()
       d.sample_yield,
       d.target_step / kDeg,
       d.refinement_factor,
+      d.min_refinement,
       d.max_window_size / kDeg,
       d.min_window_size / kDeg,
       d.margin / kDeg,
@@ -127,6 +131,7 @@ parseRegionOptions(int argc,
       !parseNumber(argc, argv, "-roi_yield", p.sample_yield) ||
       !parseNumber(argc, argv, "-roi_step_deg", step) ||
       !parseNumber(argc, argv, "-roi_refine", p.refinement_factor) ||
+      !parseNumber(argc, argv, "-roi_min_refinement", p.min_refinement) ||
       !parseNumber(argc, argv, "-roi_max_window_deg", max_window) ||
       !parseNumber(argc, argv, "-roi_min_window_deg", min_window) ||
       !parseNumber(argc, argv, "-roi_margin_deg", margin) ||

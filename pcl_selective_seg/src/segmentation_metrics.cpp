@@ -492,40 +492,58 @@ objectMetrics(const pcl::PointCloud<pcl::PointXYZ>& cloud,
   return true;
 }
 
+namespace {
+
+/** The checks of labelBoundaryPoints() and describeBoundaryPoints(). */
 bool
-labelBoundaryPoints(const pcl::PointCloud<pcl::PointXYZ>& cloud,
+checkBoundaryInputs(const char* function,
+                    const pcl::PointCloud<pcl::PointXYZ>& cloud,
                     const std::vector<std::array<pcl::index_t, 3>>& triangles,
                     const std::vector<std::uint32_t>& labels,
                     const Eigen::Vector3f& sensor_origin,
-                    double max_edge_angle,
-                    pcl::Indices& boundary)
+                    double max_edge_angle)
 {
-  boundary.clear();
   const std::size_t n = cloud.size();
   if (labels.size() != n) {
-    PCL_ERROR("[pcl::selective_seg::metrics::labelBoundaryPoints] points (%zu) and "
-              "labels (%zu) differ\n",
-              n,
-              labels.size());
+    PCL_ERROR(
+        "[pcl::selective_seg::metrics::%s] points (%zu) and labels (%zu) differ\n",
+        function,
+        n,
+        labels.size());
     return false;
   }
   if (!(max_edge_angle > 0.0) || !sensor_origin.allFinite()) {
-    PCL_ERROR("[pcl::selective_seg::metrics::labelBoundaryPoints] max edge angle %g "
-              "must be > 0 [rad] and the sensor origin finite\n",
+    PCL_ERROR("[pcl::selective_seg::metrics::%s] max edge angle %g must be > 0 [rad] "
+              "and the sensor origin finite\n",
+              function,
               max_edge_angle);
     return false;
   }
   for (const auto& t : triangles)
     for (const auto v : t)
       if (v < 0 || static_cast<std::size_t>(v) >= n) {
-        PCL_ERROR("[pcl::selective_seg::metrics::labelBoundaryPoints] triangle vertex "
-                  "%d out of range [0, %zu)\n",
+        PCL_ERROR("[pcl::selective_seg::metrics::%s] triangle vertex %d out of range "
+                  "[0, %zu)\n",
+                  function,
                   static_cast<int>(v),
                   n);
         return false;
       }
+  return true;
+}
+
+/** Call f(nearer, farther) for every boundary edge of labelBoundaryPoints(), once per
+ * triangle side (an inner edge twice). Inputs checked by checkBoundaryInputs(). */
+template <typename F>
+void
+forEachBoundaryEdge(const pcl::PointCloud<pcl::PointXYZ>& cloud,
+                    const std::vector<std::array<pcl::index_t, 3>>& triangles,
+                    const std::vector<std::uint32_t>& labels,
+                    const Eigen::Vector3f& sensor_origin,
+                    double max_edge_angle,
+                    F&& f)
+{
   const double cos_max = max_edge_angle >= M_PI ? -2.0 : std::cos(max_edge_angle);
-  std::vector<char> is_boundary(n, 0);
   for (const auto& t : triangles)
     for (int k = 0; k < 3; ++k) {
       const pcl::index_t a = t[k];
@@ -543,11 +561,149 @@ labelBoundaryPoints(const pcl::PointCloud<pcl::PointXYZ>& cloud,
       if (!(na > 0.0 && nb > 0.0) || ra.dot(rb) < cos_max * na * nb)
         continue;
       const bool a_nearer = na < nb || (na == nb && a < b);
-      is_boundary[a_nearer ? a : b] = 1;
+      f(a_nearer ? a : b, a_nearer ? b : a);
     }
+}
+
+} // namespace
+
+bool
+labelBoundaryPoints(const pcl::PointCloud<pcl::PointXYZ>& cloud,
+                    const std::vector<std::array<pcl::index_t, 3>>& triangles,
+                    const std::vector<std::uint32_t>& labels,
+                    const Eigen::Vector3f& sensor_origin,
+                    double max_edge_angle,
+                    pcl::Indices& boundary)
+{
+  boundary.clear();
+  const std::size_t n = cloud.size();
+  if (!checkBoundaryInputs("labelBoundaryPoints",
+                           cloud,
+                           triangles,
+                           labels,
+                           sensor_origin,
+                           max_edge_angle))
+    return false;
+  std::vector<char> is_boundary(n, 0);
+  forEachBoundaryEdge(
+      cloud,
+      triangles,
+      labels,
+      sensor_origin,
+      max_edge_angle,
+      [&](pcl::index_t nearer, pcl::index_t) { is_boundary[nearer] = 1; });
   for (std::size_t i = 0; i < n; ++i)
     if (is_boundary[i])
       boundary.push_back(static_cast<pcl::index_t>(i));
+  return true;
+}
+
+bool
+describeBoundaryPoints(const pcl::PointCloud<pcl::PointXYZ>& cloud,
+                       const std::vector<std::array<pcl::index_t, 3>>& triangles,
+                       const std::vector<std::uint32_t>& labels,
+                       const Eigen::Vector3f& sensor_origin,
+                       double max_edge_angle,
+                       double max_view_incidence_angle,
+                       const pcl::Indices& boundary,
+                       std::vector<BoundaryEdgeKind>& kinds)
+{
+  kinds.clear();
+  const std::size_t n = cloud.size();
+  if (!checkBoundaryInputs("describeBoundaryPoints",
+                           cloud,
+                           triangles,
+                           labels,
+                           sensor_origin,
+                           max_edge_angle))
+    return false;
+  if (!(max_view_incidence_angle > 0.0 && max_view_incidence_angle <= M_PI / 2)) {
+    PCL_ERROR("[pcl::selective_seg::metrics::describeBoundaryPoints] view incidence "
+              "angle %g must be in (0, pi/2] [rad]\n",
+              max_view_incidence_angle);
+    return false;
+  }
+  std::vector<std::size_t> slot(n, std::numeric_limits<std::size_t>::max());
+  for (std::size_t k = 0; k < boundary.size(); ++k) {
+    const pcl::index_t i = boundary[k];
+    if (i < 0 || static_cast<std::size_t>(i) >= n) {
+      PCL_ERROR("[pcl::selective_seg::metrics::describeBoundaryPoints] boundary point "
+                "%d out of range [0, %zu)\n",
+                static_cast<int>(i),
+                n);
+      return false;
+    }
+    slot[i] = k;
+  }
+  // Sensor-facing, area-weighted normal of every triangle with finite corners.
+  std::vector<Eigen::Vector3d> normal(triangles.size(), Eigen::Vector3d::Zero());
+  std::vector<std::size_t> first(n + 1, 0);
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    const Eigen::Vector3d p0 = cloud[triangles[t][0]].getVector3fMap().cast<double>();
+    const Eigen::Vector3d p1 = cloud[triangles[t][1]].getVector3fMap().cast<double>();
+    const Eigen::Vector3d p2 = cloud[triangles[t][2]].getVector3fMap().cast<double>();
+    Eigen::Vector3d m = (p1 - p0).cross(p2 - p0);
+    if (!m.allFinite() || m.isZero())
+      continue; // no side normal from a degenerate triangle
+    if (m.dot(sensor_origin.cast<double>() - (p0 + p1 + p2) / 3.0) < 0.0)
+      m = -m;
+    normal[t] = m;
+    for (const auto v : triangles[t])
+      ++first[v + 1];
+  }
+  for (std::size_t i = 0; i < n; ++i)
+    first[i + 1] += first[i];
+  std::vector<std::size_t> incident(first[n]);
+  {
+    std::vector<std::size_t> next(first.begin(), first.end() - 1);
+    for (std::size_t t = 0; t < triangles.size(); ++t)
+      if (!normal[t].isZero())
+        for (const auto v : triangles[t])
+          incident[next[v]++] = t;
+  }
+  // Normal of the surface of v's own label at v; zero when no triangle has it at
+  // all three corners.
+  const auto sideNormal = [&](pcl::index_t v) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (std::size_t k = first[v]; k < first[v + 1]; ++k) {
+      const auto& t = triangles[incident[k]];
+      if (labels[t[0]] == labels[v] && labels[t[1]] == labels[v] &&
+          labels[t[2]] == labels[v])
+        sum += normal[incident[k]];
+    }
+    return sum;
+  };
+  const double sin_jump = std::sin(M_PI / 2 - max_view_incidence_angle);
+  kinds.assign(boundary.size(), BoundaryEdgeKind());
+  forEachBoundaryEdge(
+      cloud,
+      triangles,
+      labels,
+      sensor_origin,
+      max_edge_angle,
+      [&](pcl::index_t nearer, pcl::index_t farther) {
+        if (slot[nearer] == std::numeric_limits<std::size_t>::max())
+          return;
+        BoundaryEdgeKind& kind = kinds[slot[nearer]];
+        const Eigen::Vector3d a = cloud[nearer].getVector3fMap().cast<double>();
+        const Eigen::Vector3d b = cloud[farther].getVector3fMap().cast<double>();
+        const Eigen::Vector3d edge = b - a;
+        const Eigen::Vector3d sight = (a + b) / 2.0 - sensor_origin.cast<double>();
+        // Angle between the edge and the line of sight below 90 deg - incidence:
+        // |edge x sight| < sin(90 deg - incidence) |edge| |sight|.
+        if (edge.cross(sight).norm() < sin_jump * edge.norm() * sight.norm()) {
+          kind.depth_jump = true;
+          return;
+        }
+        const Eigen::Vector3d na = sideNormal(nearer);
+        const Eigen::Vector3d nb = sideNormal(farther);
+        if (na.isZero() || nb.isZero())
+          return;
+        const float angle =
+            static_cast<float>(std::atan2(na.cross(nb).norm(), na.dot(nb)));
+        if (std::isnan(kind.crease_angle) || angle > kind.crease_angle)
+          kind.crease_angle = angle;
+      });
   return true;
 }
 

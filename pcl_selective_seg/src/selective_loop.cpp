@@ -112,6 +112,16 @@ makeReferenceBoundary(const SimulationSetup& setup,
                                     4.0 * step,
                                     boundary))
     return false;
+  if (!metrics::describeBoundaryPoints(
+          xyz,
+          triangles,
+          labelsOf(*cloud),
+          Eigen::Vector3f::Zero(),
+          4.0 * step,
+          SelectiveSegmentationParameters().max_view_incidence_angle,
+          boundary,
+          reference.kinds))
+    return false;
   for (const auto i : boundary)
     reference.points.push_back(xyz[i]);
   reference.scan_points = cloud->size();

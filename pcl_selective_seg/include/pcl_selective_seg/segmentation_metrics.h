@@ -14,6 +14,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 namespace pcl {
@@ -316,6 +317,48 @@ labelBoundaryPoints(const pcl::PointCloud<pcl::PointXYZ>& cloud,
                     const Eigen::Vector3f& sensor_origin,
                     double max_edge_angle,
                     pcl::Indices& boundary);
+
+/** \brief The kind of true edge a boundary point lies on (describeBoundaryPoints()). */
+struct BoundaryEdgeKind {
+  /** At least one of the point's boundary edges is seen edge-on: a depth jump. */
+  bool depth_jump = false;
+  /** The largest angle between the surface normals on the two sides of the point's
+   * other boundary edges [rad]: 0 on a smooth (C1) border between two labels, the
+   * dihedral angle's complement on a crease (90 deg between two faces of a box). NaN
+   * when no such edge has triangles of its own label on both sides. */
+  float crease_angle = std::numeric_limits<float>::quiet_NaN();
+};
+
+/** \brief Describe the boundary points of labelBoundaryPoints() by the edges they lie
+ * on: depth jump or crease, and how sharp the crease is.
+ *
+ * The boundary edges of a point are those of labelBoundaryPoints() whose nearer end
+ * point it is. An edge is a depth jump when the angle between it and the line of sight
+ * to its midpoint is less than 90 deg - \a max_view_incidence_angle (seen edge-on).
+ * Otherwise the normal of each side is the sum of the (area-weighted, sensor-facing)
+ * normals of the triangles at that end point whose three corners carry its label, and
+ * the crease angle is the angle between the two sides' normals. Meant for dense,
+ * noise-free reference scans with ground-truth labels (simulation): on them the
+ * triangle normals are the surfaces' normals.
+ *
+ * \param[in] cloud, triangles, labels, sensor_origin, max_edge_angle as for
+ *            labelBoundaryPoints()
+ * \param[in] max_view_incidence_angle edges closer than 90 deg minus this to the line
+ *            of sight are depth jumps [rad], in (0, pi/2]
+ * \param[in] boundary the boundary points (labelBoundaryPoints() of the same input)
+ * \param[out] kinds one per boundary point, in its order; empty on failure
+ * \return false (with PCL_ERROR) on the inputs labelBoundaryPoints() refuses, a bad
+ *         incidence angle or a boundary index out of range
+ */
+PCL_EXPORTS bool
+describeBoundaryPoints(const pcl::PointCloud<pcl::PointXYZ>& cloud,
+                       const std::vector<std::array<pcl::index_t, 3>>& triangles,
+                       const std::vector<std::uint32_t>& labels,
+                       const Eigen::Vector3f& sensor_origin,
+                       double max_edge_angle,
+                       double max_view_incidence_angle,
+                       const pcl::Indices& boundary,
+                       std::vector<BoundaryEdgeKind>& kinds);
 
 /** \brief Distances from one set of boundary points to the nearest point of another. */
 struct BoundaryDistances {

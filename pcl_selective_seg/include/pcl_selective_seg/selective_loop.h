@@ -27,6 +27,10 @@ namespace simulation {
  * spherical Delaunay mesh of a very dense, noise-free scan. */
 struct PCL_EXPORTS ReferenceBoundary {
   pcl::PointCloud<pcl::PointXYZ> points; ///< the boundary points [m]
+  /** The true edge each point lies on (metrics::describeBoundaryPoints() with the
+   * segmentation's default max_view_incidence_angle, 85 deg), in the order of points.
+   */
+  std::vector<metrics::BoundaryEdgeKind> kinds;
   std::size_t scan_points = 0;           ///< points of the reference scan
   double step = 0.0;                     ///< its angular step [rad]
 };
