@@ -310,6 +310,42 @@ TEST(RegionsOfInterest, EdgeTrianglesBetweenAgreeingSegmentsAreNoEvidence)
   EXPECT_EQ(evidence(), 0u);
 }
 
+// min_side_points: the normals of small segments (often fragments that range noise
+// cut out of one surface) do not tell two surfaces apart; a depth jump still does.
+TEST(RegionsOfInterest, SmallSegmentsMakeNoTwoSurfacesWithMinSidePoints)
+{
+  GridMesh g = makeGrid(10, 8, 0.01, 3, {4, 7}); // two segments of 40 points
+  RegionOfInterestParameters p;
+  p.sparse_factor = 0.0;
+  p.small_segment_points = 0;
+  p.max_window_size = 1.0;
+  p.min_side_angle = 25.0 * M_PI / 180.0;
+  const auto evidence = [&]() {
+    std::vector<RegionOfInterest> regions;
+    RegionOfInterestStats stats;
+    EXPECT_TRUE(computeRegionsOfInterest(
+        g.result, g.tri, Eigen::Affine3f::Identity(), p, regions, &stats));
+    return stats.transition_vertices;
+  };
+  // Normals 30 deg apart: a crease between segments of 40 points.
+  g.result.segments[0].normal = Eigen::Vector3f(0.0f, 0.0f, -1.0f);
+  g.result.segments[1].normal =
+      Eigen::Vector3f(0.0f, static_cast<float>(-std::sin(M_PI / 6)), -0.866025f);
+  EXPECT_EQ(evidence(), 20u);
+  p.min_side_points = 40;
+  EXPECT_EQ(evidence(), 20u);
+  p.min_side_points = 41; // both sides must hold as many
+  EXPECT_EQ(evidence(), 0u);
+  g.result.segments[0].num_points = 1000;
+  EXPECT_EQ(evidence(), 0u);
+  // The same band seen edge-on (segment 2 pushed 2 m back): a depth jump, whatever
+  // the segments' sizes.
+  for (std::size_t v = 0; v < g.tri.vertex_positions.size(); ++v)
+    if (g.result.labels[g.tri.vertex_point[v]] == 2)
+      g.tri.vertex_positions[v] *= 3.0f;
+  EXPECT_EQ(evidence(), 20u);
+}
+
 // use_edge_on: a depth jump inside one segment (two surfaces at different depths
 // whose normals agree, merged) is transition evidence.
 TEST(RegionsOfInterest, EdgeOnTrianglesInsideASegmentAreEvidence)

@@ -153,6 +153,9 @@ TEST_F(ToolRegions, BadBudgetIsAUsageErrorWithNoOutput)
             2);
   EXPECT_EQ(
       run(out("cube.pcd") + " -roi_json " + out("rois.json") + " -roi_weights 1,2"), 2);
+  EXPECT_EQ(
+      run(out("cube.pcd") + " -roi_json " + out("rois.json") + " -roi_side_points 2.5"),
+      2);
   EXPECT_FALSE(fs::exists(out("labels.pcd")));
   EXPECT_FALSE(fs::exists(out("rois.json")));
 }

@@ -29,7 +29,8 @@ regionFlags()
       "-roi_margin_deg",     "-roi_margin_spacings", "-roi_small_points",
       "-roi_min_component",  "-roi_valid_edges",     "-roi_sparse_factor",
       "-roi_leaf_sigma_deg", "-roi_side_deg",        "-roi_edge_on_deg",
-      "-roi_edge_on",        "-roi_sparse_by_area",  "-roi_weights"};
+      "-roi_edge_on",        "-roi_sparse_by_area",  "-roi_weights",
+      "-roi_side_points"};
   return flags;
 }
 
@@ -74,6 +75,8 @@ printRegionHelp()
       "edge-on or between segments\n"
       "                           whose normals differ by more than X; 0 = off "
       "(default %g)\n"
+      "  -roi_side_points N       ... and only between segments of at least N "
+      "points; 0 = off (default %zu)\n"
       "  -roi_edge_on 0|1         triangles seen edge-on (depth jumps) are "
       "transition evidence (default %d)\n"
       "  -roi_edge_on_deg X       edge-on: more than X between the triangle normal "
@@ -100,6 +103,7 @@ printRegionHelp()
       d.sparse_by_area ? 1 : 0,
       d.leaf_sigma_threshold / kDeg,
       d.min_side_angle / kDeg,
+      d.min_side_points,
       d.use_edge_on ? 1 : 0,
       d.edge_on_angle / kDeg,
       d.transition_weight,
@@ -121,6 +125,7 @@ parseRegionOptions(int argc,
   double max_points = static_cast<double>(p.max_points),
          max_regions = static_cast<double>(p.max_regions),
          small = static_cast<double>(p.small_segment_points),
+         side_points = static_cast<double>(p.min_side_points),
          component = static_cast<double>(p.min_component_vertices),
          valid_edges = p.use_valid_edges ? 1.0 : 0.0,
          edge_on_triangles = p.use_edge_on ? 1.0 : 0.0,
@@ -142,6 +147,7 @@ parseRegionOptions(int argc,
       !parseNumber(argc, argv, "-roi_sparse_factor", p.sparse_factor) ||
       !parseNumber(argc, argv, "-roi_leaf_sigma_deg", sigma) ||
       !parseNumber(argc, argv, "-roi_side_deg", side) ||
+      !parseNumber(argc, argv, "-roi_side_points", side_points) ||
       !parseNumber(argc, argv, "-roi_edge_on_deg", edge_on) ||
       !parseNumber(argc, argv, "-roi_edge_on", edge_on_triangles) ||
       !parseNumber(argc, argv, "-roi_sparse_by_area", by_area))
@@ -149,6 +155,7 @@ parseRegionOptions(int argc,
   for (const auto& [flag, value] : {std::make_pair("-roi_max_points", max_points),
                                     std::make_pair("-roi_max_regions", max_regions),
                                     std::make_pair("-roi_small_points", small),
+                                    std::make_pair("-roi_side_points", side_points),
                                     std::make_pair("-roi_min_component", component)})
     if (!(value >= 0.0 && value <= 1e15 && value == std::floor(value))) {
       pcl::console::print_error("Option %s needs a whole number >= 0.\n", flag);
@@ -171,6 +178,7 @@ parseRegionOptions(int argc,
   p.max_points = static_cast<std::size_t>(max_points);
   p.max_regions = static_cast<std::size_t>(max_regions);
   p.small_segment_points = static_cast<std::size_t>(small);
+  p.min_side_points = static_cast<std::size_t>(side_points);
   p.min_component_vertices = static_cast<std::size_t>(component);
   if (valid_edges != 0.0 && valid_edges != 1.0) {
     pcl::console::print_error("Option -roi_valid_edges needs 0 or 1.\n");

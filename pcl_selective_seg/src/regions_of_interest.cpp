@@ -247,8 +247,8 @@ edgeOn(const SphericalTriangulation& tri,
 }
 
 /** Whether edge triangle \a t separates two surfaces (min_side_angle): seen edge-on,
- * a corner without a segment, or segments whose normals differ by more than
- * min_side_angle. */
+ * a corner without a segment, or segments of at least min_side_points points whose
+ * normals differ by more than min_side_angle. */
 bool
 twoSurfaces(const SegmentationResult& result,
             const SphericalTriangulation& tri,
@@ -269,9 +269,11 @@ twoSurfaces(const SegmentationResult& result,
     for (int j = i + 1; j < 3; ++j) {
       if (labels[i] == labels[j])
         continue;
-      const Eigen::Vector3f& ni = result.segments[labels[i] - 1].normal;
-      const Eigen::Vector3f& nj = result.segments[labels[j] - 1].normal;
-      if (static_cast<double>(ni.dot(nj)) < cos_side)
+      const Segment& si = result.segments[labels[i] - 1];
+      const Segment& sj = result.segments[labels[j] - 1];
+      if (si.num_points < p.min_side_points || sj.num_points < p.min_side_points)
+        continue;
+      if (static_cast<double>(si.normal.dot(sj.normal)) < cos_side)
         return true;
     }
   return false;

@@ -61,6 +61,13 @@ struct PCL_EXPORTS RegionOfInterestParameters {
    * segment. Edge triangles between segments whose normals agree are splits by range
    * noise, not transitions. 0: every edge triangle is evidence. Valid: [0, pi]. */
   double min_side_angle = 0.0;
+  /** \brief With min_side_angle > 0: the normals of two segments tell two surfaces
+   * apart only when both segments hold at least this many points. The borders of
+   * smaller segments, often fragments that range noise cut out of one surface, are
+   * then no transition evidence unless seen edge-on (the small segments remain
+   * small-segment evidence, small_segment_points). It trades small true parts for
+   * noise fragments: docs/selective_sensing.md measures both. 0: off. */
+  std::size_t min_side_points = 0;
   /** \brief See use_edge_on and min_side_angle [rad]; the segmentation's
    * max_view_incidence_angle (85 deg by default) is the natural value. Valid: (0,
    * pi/2]. */
