@@ -101,7 +101,8 @@ printHelp(const char* program)
       "The loop sets the regions' step (the fine step), point budget and yield; the "
       "other\nregion options apply (the budget flags are ignored). The loop's own "
       "defaults differ from those\nlisted below: -roi_margin_spacings 0.5 "
-      "-roi_valid_edges 1 -roi_edge_on 1 -roi_side_deg 25 -roi_sparse_by_area 1:\n",
+      "-roi_valid_edges 1 -roi_edge_on 1 -roi_side_deg 25 -roi_side_confidence 0.95\n"
+      "-roi_sparse_by_area 1:\n",
       program,
       defaults.iterations,
       defaults.coarse_factor,

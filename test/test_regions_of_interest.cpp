@@ -346,6 +346,83 @@ TEST(RegionsOfInterest, SmallSegmentsMakeNoTwoSurfacesWithMinSidePoints)
   EXPECT_EQ(evidence(), 20u);
 }
 
+// Fisher's cone of confidence, by hand: two unit vectors 2 deg apart have R = 2 cos 1
+// deg, and at 95% cos a = 1 - (2 - R) / R (20 - 1).
+TEST(RegionsOfInterest, FisherConfidenceAngleKnownValues)
+{
+  const double d = M_PI / 180.0;
+  const double r = 2.0 * std::cos(d);
+  const double expected = std::acos(1.0 - (2.0 - r) / r * 19.0); // 4.36 deg
+  EXPECT_NEAR(fisherConfidenceAngle(2, r, 0.95), expected, 1e-12);
+  EXPECT_NEAR(expected / d, 4.36, 0.01);
+  // Identical vectors: no uncertainty; more of them with the same spread: a narrower
+  // cone; a higher confidence: a wider one.
+  EXPECT_EQ(fisherConfidenceAngle(10, 10.0, 0.95), 0.0);
+  EXPECT_LT(fisherConfidenceAngle(20, 20.0 * std::cos(d), 0.95),
+            fisherConfidenceAngle(2, r, 0.95));
+  EXPECT_GT(fisherConfidenceAngle(2, r, 0.99), fisherConfidenceAngle(2, r, 0.95));
+  // Undefined: one vector, vectors that cancel, spread too wide for the level.
+  EXPECT_EQ(fisherConfidenceAngle(1, 1.0, 0.95), M_PI);
+  EXPECT_EQ(fisherConfidenceAngle(0, 0.0, 0.95), M_PI);
+  EXPECT_EQ(fisherConfidenceAngle(4, 0.0, 0.95), M_PI);
+  EXPECT_EQ(fisherConfidenceAngle(2, 0.2, 0.95), M_PI);
+}
+
+// side_confidence: a 30 deg crease between segments counts against a 25 deg
+// min_side_angle only while the segments' normals are certain to better than 5 deg
+// together; noisy facets widen the cone and the crease is no longer evidence.
+TEST(RegionsOfInterest, UncertainSegmentNormalsMakeNoTwoSurfaces)
+{
+  GridMesh g = makeGrid(10, 8, 0.01, 3, {4, 7});
+  RegionOfInterestParameters p;
+  p.sparse_factor = 0.0;
+  p.small_segment_points = 0;
+  p.max_window_size = 1.0;
+  p.min_side_angle = 25.0 * M_PI / 180.0;
+  p.side_confidence = 0.95;
+  const auto evidence = [&]() {
+    std::vector<RegionOfInterest> regions;
+    RegionOfInterestStats stats;
+    EXPECT_TRUE(computeRegionsOfInterest(
+        g.result, g.tri, Eigen::Affine3f::Identity(), p, regions, &stats));
+    return stats.transition_vertices;
+  };
+  g.result.segments[0].normal = Eigen::Vector3f(0.0f, 0.0f, -1.0f);
+  g.result.segments[1].normal =
+      Eigen::Vector3f(0.0f, static_cast<float>(-std::sin(M_PI / 6)), -0.866025f);
+  // Both segments planar (54 facets each, all with one normal): cones of 0.
+  EXPECT_EQ(evidence(), 20u);
+  // Every other row of segment 2 pushed back along its rays by 1 cm (rows 1 cm apart
+  // at 1 m): its 54 facets tilt by about 45 deg to either side, a cone of about
+  // 11 deg.
+  const auto bump = [&](float depth) {
+    for (std::size_t v = 0; v < g.tri.vertex_positions.size(); ++v)
+      if (g.result.labels[g.tri.vertex_point[v]] == 2 && (v % 8) % 2 == 1)
+        g.tri.vertex_positions[v] *= 1.0f + depth;
+  };
+  bump(0.01f);
+  EXPECT_EQ(evidence(), 0u);
+  p.side_confidence = 0.0; // off: the plain comparison of the normals
+  EXPECT_EQ(evidence(), 20u);
+  // A bump a hundred times smaller (facets tilted by 0.6 deg): a cone of a tenth of a
+  // degree, the crease counts again.
+  p.side_confidence = 0.95;
+  bump(-0.01f / 1.01f);
+  bump(0.0001f);
+  EXPECT_EQ(evidence(), 20u);
+  // Seen edge-on (segment 2 pushed 2 m back), the band is a depth jump whatever the
+  // cones.
+  bump(0.3f);
+  for (std::size_t v = 0; v < g.tri.vertex_positions.size(); ++v)
+    if (g.result.labels[g.tri.vertex_point[v]] == 2)
+      g.tri.vertex_positions[v] *= 3.0f;
+  EXPECT_EQ(evidence(), 20u);
+  p.side_confidence = 1.0;
+  std::vector<RegionOfInterest> regions;
+  EXPECT_FALSE(computeRegionsOfInterest(
+      g.result, g.tri, Eigen::Affine3f::Identity(), p, regions));
+}
+
 // use_edge_on: a depth jump inside one segment (two surfaces at different depths
 // whose normals agree, merged) is transition evidence.
 TEST(RegionsOfInterest, EdgeOnTrianglesInsideASegmentAreEvidence)

@@ -156,6 +156,9 @@ TEST_F(ToolRegions, BadBudgetIsAUsageErrorWithNoOutput)
   EXPECT_EQ(
       run(out("cube.pcd") + " -roi_json " + out("rois.json") + " -roi_side_points 2.5"),
       2);
+  EXPECT_EQ(run(out("cube.pcd") + " -roi_json " + out("rois.json") +
+                " -roi_side_confidence 1"),
+            2);
   EXPECT_FALSE(fs::exists(out("labels.pcd")));
   EXPECT_FALSE(fs::exists(out("rois.json")));
 }

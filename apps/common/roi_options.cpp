@@ -30,7 +30,7 @@ regionFlags()
       "-roi_min_component",  "-roi_valid_edges",     "-roi_sparse_factor",
       "-roi_leaf_sigma_deg", "-roi_side_deg",        "-roi_edge_on_deg",
       "-roi_edge_on",        "-roi_sparse_by_area",  "-roi_weights",
-      "-roi_side_points"};
+      "-roi_side_points",    "-roi_side_confidence"};
   return flags;
 }
 
@@ -77,6 +77,10 @@ printRegionHelp()
       "(default %g)\n"
       "  -roi_side_points N       ... and only between segments of at least N "
       "points; 0 = off (default %zu)\n"
+      "  -roi_side_confidence C   ... and only when the normals differ by more than "
+      "X plus their cones of\n"
+      "                           confidence at level C (0 < C < 1); 0 = off "
+      "(default %g)\n"
       "  -roi_edge_on 0|1         triangles seen edge-on (depth jumps) are "
       "transition evidence (default %d)\n"
       "  -roi_edge_on_deg X       edge-on: more than X between the triangle normal "
@@ -104,6 +108,7 @@ printRegionHelp()
       d.leaf_sigma_threshold / kDeg,
       d.min_side_angle / kDeg,
       d.min_side_points,
+      d.side_confidence,
       d.use_edge_on ? 1 : 0,
       d.edge_on_angle / kDeg,
       d.transition_weight,
@@ -148,6 +153,7 @@ parseRegionOptions(int argc,
       !parseNumber(argc, argv, "-roi_leaf_sigma_deg", sigma) ||
       !parseNumber(argc, argv, "-roi_side_deg", side) ||
       !parseNumber(argc, argv, "-roi_side_points", side_points) ||
+      !parseNumber(argc, argv, "-roi_side_confidence", p.side_confidence) ||
       !parseNumber(argc, argv, "-roi_edge_on_deg", edge_on) ||
       !parseNumber(argc, argv, "-roi_edge_on", edge_on_triangles) ||
       !parseNumber(argc, argv, "-roi_sparse_by_area", by_area))

@@ -246,14 +246,53 @@ edgeOn(const SphericalTriangulation& tri,
   return std::abs(normal.dot(ray)) < std::cos(p.edge_on_angle) * n;
 }
 
+/** Per segment, the cone of confidence of its mean normal at side_confidence
+ * (fisherConfidenceAngle()) over the unit normals of its interior triangles (all
+ * three corners in it), from the triangulation's sensor-frame positions, each turned
+ * toward the sensor; empty when side_confidence is off. */
+std::vector<double>
+sideCones(const SegmentationResult& result,
+          const SphericalTriangulation& tri,
+          const RegionOfInterestParameters& p)
+{
+  if (!(p.min_side_angle > 0.0 && p.side_confidence > 0.0))
+    return {};
+  const std::size_t ns = result.segments.size();
+  std::vector<Eigen::Vector3d> sum(ns, Eigen::Vector3d::Zero());
+  std::vector<std::size_t> count(ns, 0);
+  for (const auto& corners : tri.triangles) {
+    const std::uint32_t label = result.labels[tri.vertex_point[corners[0]]];
+    if (label == 0 || label > ns ||
+        result.labels[tri.vertex_point[corners[1]]] != label ||
+        result.labels[tri.vertex_point[corners[2]]] != label)
+      continue;
+    const Eigen::Vector3d a = tri.vertex_positions[corners[0]].cast<double>();
+    const Eigen::Vector3d b = tri.vertex_positions[corners[1]].cast<double>();
+    const Eigen::Vector3d c = tri.vertex_positions[corners[2]].cast<double>();
+    Eigen::Vector3d n = (b - a).cross(c - a);
+    const double length = n.norm();
+    if (!(length > 0.0) || !std::isfinite(length))
+      continue;
+    n /= length;
+    sum[label - 1] += n.dot(a) > 0.0 ? -n : n; // toward the sensor at the origin
+    ++count[label - 1];
+  }
+  std::vector<double> cones(ns);
+  for (std::size_t i = 0; i < ns; ++i)
+    cones[i] = fisherConfidenceAngle(count[i], sum[i].norm(), p.side_confidence);
+  return cones;
+}
+
 /** Whether edge triangle \a t separates two surfaces (min_side_angle): seen edge-on,
  * a corner without a segment, or segments of at least min_side_points points whose
- * normals differ by more than min_side_angle. */
+ * normals differ by more than min_side_angle (plus their cones of confidence, \a
+ * cones, when side_confidence is on). */
 bool
 twoSurfaces(const SegmentationResult& result,
             const SphericalTriangulation& tri,
             std::size_t t,
-            const RegionOfInterestParameters& p)
+            const RegionOfInterestParameters& p,
+            const std::vector<double>& cones)
 {
   if (!(p.min_side_angle > 0.0) || edgeOn(tri, t, p))
     return true;
@@ -273,7 +312,15 @@ twoSurfaces(const SegmentationResult& result,
       const Segment& sj = result.segments[labels[j] - 1];
       if (si.num_points < p.min_side_points || sj.num_points < p.min_side_points)
         continue;
-      if (static_cast<double>(si.normal.dot(sj.normal)) < cos_side)
+      const double cos_ij = static_cast<double>(si.normal.dot(sj.normal));
+      if (cones.empty()) {
+        if (cos_ij < cos_side)
+          return true;
+        continue;
+      }
+      const double ci = cones[labels[i] - 1], cj = cones[labels[j] - 1];
+      if (std::acos(std::clamp(cos_ij, -1.0, 1.0)) - std::sqrt(ci * ci + cj * cj) >
+          p.min_side_angle)
         return true;
     }
   return false;
@@ -297,10 +344,11 @@ findEvidence(const SegmentationResult& result,
     kinds[v] |= kTransition;
     transition_strength[v] = std::max(transition_strength[v], weight);
   };
+  const std::vector<double> cones = sideCones(result, tri, p);
   for (std::size_t t = 0; t < tri.triangles.size(); ++t) {
     const auto c = result.mesh.classes[t];
     if ((c == TriangleClass::InvalidEdge || c == TriangleClass::ValidEdge) &&
-        !twoSurfaces(result, tri, t, p))
+        !twoSurfaces(result, tri, t, p, cones))
       continue;
     if ((p.use_invalid_edges && c == TriangleClass::InvalidEdge) ||
         (p.use_edge_on && edgeOn(tri, t, p, false)))
@@ -530,6 +578,18 @@ reasonsToString(std::uint8_t reasons)
   return s;
 }
 
+double
+fisherConfidenceAngle(std::size_t n, double resultant, double confidence)
+{
+  if (n < 2 || !(resultant > 0.0) || !(confidence > 0.0 && confidence < 1.0))
+    return M_PI;
+  const double nd = static_cast<double>(n);
+  const double r = std::min(resultant, nd);
+  const double c =
+      1.0 - (nd - r) / r * (std::pow(1.0 / (1.0 - confidence), 1.0 / (nd - 1.0)) - 1.0);
+  return c < -1.0 ? M_PI : std::acos(std::min(c, 1.0));
+}
+
 bool
 RegionOfInterestParameters::validate(std::string* why) const
 {
@@ -537,6 +597,8 @@ RegionOfInterestParameters::validate(std::string* why) const
     return reject(why, "leaf_sigma_threshold", leaf_sigma_threshold, "finite [rad]");
   if (!(min_side_angle >= 0.0 && min_side_angle <= M_PI))
     return reject(why, "min_side_angle", min_side_angle, "[0, pi] [rad]");
+  if (!(side_confidence >= 0.0 && side_confidence < 1.0))
+    return reject(why, "side_confidence", side_confidence, "[0, 1)");
   if (!(edge_on_angle > 0.0 && edge_on_angle <= kHalfPi))
     return reject(why, "edge_on_angle", edge_on_angle, "(0, pi/2] [rad]");
   if (!(sparse_factor == 0.0 || finiteAtLeast(sparse_factor, 1.0)))

@@ -76,6 +76,7 @@ loopRegionParameters()
   p.use_edge_on = true;
   p.edge_on_angle = 85.0 * M_PI / 180.0;
   p.min_side_angle = 25.0 * M_PI / 180.0;
+  p.side_confidence = 0.95;
   p.sparse_by_area = true;
   return p;
 }

@@ -68,6 +68,16 @@ struct PCL_EXPORTS RegionOfInterestParameters {
    * small-segment evidence, small_segment_points). It trades small true parts for
    * noise fragments: docs/selective_sensing.md measures both. 0: off. */
   std::size_t min_side_points = 0;
+  /** \brief With min_side_angle > 0 and a value in (0, 1): two segments are two
+   * surfaces by their normals only when the angle between them exceeds
+   * min_side_angle by more than the uncertainty of that angle, sqrt(a_i^2 + a_j^2),
+   * where a is the cone of confidence at this level of a segment's mean normal
+   * (fisherConfidenceAngle() over the unit normals of its interior triangles). A
+   * segment a few noisy triangles wide, whose normal differs from its neighbour's
+   * only by chance, then makes no transition evidence; one with fewer than two
+   * interior triangles never does by its normal (edge-on triangles and corners
+   * without a segment still count). 0: off, the plain comparison. Valid: [0, 1). */
+  double side_confidence = 0.0;
   /** \brief See use_edge_on and min_side_angle [rad]; the segmentation's
    * max_view_incidence_angle (85 deg by default) is the natural value. Valid: (0,
    * pi/2]. */
@@ -197,6 +207,14 @@ struct RegionOfInterestStats {
  * is a rectangle on the plane z = 1). */
 PCL_EXPORTS double
 windowSolidAngle(double theta_min, double theta_max, double phi_min, double phi_max);
+
+/** \brief Semi-angle of the cone of confidence of the mean of \a n unit vectors
+ * whose sum has length \a resultant (Fisher, 1953): the true mean direction lies
+ * within it with probability \a confidence, cos a = 1 - (n - R) / R ((1 / (1 -
+ * confidence))^(1 / (n - 1)) - 1). Returns pi when it is not defined (n < 2, R <= 0,
+ * or the cosine below -1) [rad]. \a confidence in (0, 1). */
+PCL_EXPORTS double
+fisherConfidenceAngle(std::size_t n, double resultant, double confidence);
 
 /** \brief Regions of interest of a segmentation for a finer acquisition.
  *

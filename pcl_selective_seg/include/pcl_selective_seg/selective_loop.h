@@ -77,7 +77,8 @@ PCL_EXPORTS bool scoreSegmentation(const pcl::PointCloud<pcl::PointXYZL>& cloud,
  * rounds), and as transition evidence every edge triangle, valid or invalid, between
  * two surfaces: seen edge-on (a depth jump, 85 deg: the segmentation's
  * max_view_incidence_angle), or between segments whose normals differ by more than the
- * segmentation's merge angle (25 deg), whatever the triangle's class; sparse areas
+ * segmentation's merge angle (25 deg) plus their 95% cones of confidence
+ * (side_confidence), whatever the triangle's class; sparse areas
  * relative to the median spacing over the view's area, which the refined windows do
  * not shift (docs/selective_sensing.md measures each choice). */
 PCL_EXPORTS RegionOfInterestParameters loopRegionParameters();
