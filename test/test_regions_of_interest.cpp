@@ -259,91 +259,98 @@ TEST(RegionsOfInterest, WindowOverABandOfInvalidEdgeTriangles)
   EXPECT_LE(r.priority, p.transition_weight);
 }
 
-// min_side_angle: a band of invalid edge triangles between two segments is evidence
-// only when the segments' normals differ by more than the angle or the band is seen
-// edge-on (a depth jump).
-TEST(RegionsOfInterest, EdgeTrianglesBetweenAgreeingSegmentsAreNoEvidence)
-{
-  // Rows -4..3; the band between rows -1 and 0; rows 0..3 are segment 2.
+/** Two segments of 40 points on a 10 x 8 grid at 1 m (rows 4-7 are segment 2) and the
+ * band of invalid edge triangles between them; transition evidence only, with
+ * min_side_angle = 25 deg. */
+struct CreaseBand {
   GridMesh g = makeGrid(10, 8, 0.01, 3, {4, 7});
   RegionOfInterestParameters p;
-  p.sparse_factor = 0.0;
-  p.small_segment_points = 0;
-  p.max_window_size = 1.0;
-  p.min_side_angle = 25.0 * M_PI / 180.0;
-  const auto evidence = [&]() {
+
+  CreaseBand()
+  {
+    p.sparse_factor = 0.0;
+    p.small_segment_points = 0;
+    p.max_window_size = 1.0;
+    p.min_side_angle = 25.0 * M_PI / 180.0;
+    setCrease(0.0);
+  }
+  /** Transition evidence vertices. */
+  std::size_t evidence()
+  {
     std::vector<RegionOfInterest> regions;
     RegionOfInterestStats stats;
     EXPECT_TRUE(computeRegionsOfInterest(
         g.result, g.tri, Eigen::Affine3f::Identity(), p, regions, &stats));
     return stats.transition_vertices;
-  };
-  const auto tilt = [](double degrees) {
+  }
+  /** Segment 2's normal tilted by \a degrees from segment 1's. */
+  void setCrease(double degrees)
+  {
     const double a = degrees * M_PI / 180.0;
-    return Eigen::Vector3f(
+    g.result.segments[0].normal = Eigen::Vector3f(0.0f, 0.0f, -1.0f);
+    g.result.segments[1].normal = Eigen::Vector3f(
         0.0f, static_cast<float>(-std::sin(a)), static_cast<float>(-std::cos(a)));
-  };
+  }
+  /** Scale the vertices of segment 2 for which \a which(v) holds along their rays. */
+  template <typename Which> void pushBack(float factor, Which which)
+  {
+    for (std::size_t v = 0; v < g.tri.vertex_positions.size(); ++v)
+      if (g.result.labels[g.tri.vertex_point[v]] == 2 && which(v))
+        g.tri.vertex_positions[v] *= factor;
+  }
+  /** Segment 2 pushed 2 m back: the band is seen edge-on, a depth jump. */
+  void makeDepthJump()
+  {
+    pushBack(3.0f, [](std::size_t) { return true; });
+  }
+};
+
+// min_side_angle: a band of invalid edge triangles between two segments is evidence
+// only when the segments' normals differ by more than the angle or the band is seen
+// edge-on (a depth jump).
+TEST(RegionsOfInterest, EdgeTrianglesBetweenAgreeingSegmentsAreNoEvidence)
+{
+  CreaseBand band;
   // Normals 20 deg apart: the same surface split by noise.
-  g.result.segments[0].normal = tilt(0.0);
-  g.result.segments[1].normal = tilt(20.0);
-  EXPECT_EQ(evidence(), 0u);
+  band.setCrease(20.0);
+  EXPECT_EQ(band.evidence(), 0u);
   // 30 deg apart: a crease.
-  g.result.segments[1].normal = tilt(30.0);
-  EXPECT_EQ(evidence(), 20u);
+  band.setCrease(30.0);
+  EXPECT_EQ(band.evidence(), 20u);
   // Off: every edge triangle is evidence.
-  g.result.segments[1].normal = tilt(0.0);
-  p.min_side_angle = 0.0;
-  EXPECT_EQ(evidence(), 20u);
-  p.min_side_angle = 25.0 * M_PI / 180.0;
-  EXPECT_EQ(evidence(), 0u);
+  band.setCrease(0.0);
+  band.p.min_side_angle = 0.0;
+  EXPECT_EQ(band.evidence(), 20u);
+  band.p.min_side_angle = 25.0 * M_PI / 180.0;
+  EXPECT_EQ(band.evidence(), 0u);
   // A corner without a segment: evidence.
-  g.result.labels[g.tri.vertex_point[4]] = 0; // column 0, row 0
-  EXPECT_GT(evidence(), 0u);
-  g.result.labels[g.tri.vertex_point[4]] = 2;
+  auto& labels = band.g.result.labels;
+  labels[band.g.tri.vertex_point[4]] = 0; // column 0, row 0
+  EXPECT_GT(band.evidence(), 0u);
+  labels[band.g.tri.vertex_point[4]] = 2;
   // Parallel normals, but segment 2 lies 2 m behind: the band is seen edge-on.
-  for (std::size_t v = 0; v < g.tri.vertex_positions.size(); ++v)
-    if (g.result.labels[g.tri.vertex_point[v]] == 2)
-      g.tri.vertex_positions[v] *= 3.0f;
-  EXPECT_EQ(evidence(), 20u);
+  band.makeDepthJump();
+  EXPECT_EQ(band.evidence(), 20u);
   // ... unless edge-on means more than 89.9 deg (the band is at about 89.7 deg).
-  p.edge_on_angle = 89.9 * M_PI / 180.0;
-  EXPECT_EQ(evidence(), 0u);
+  band.p.edge_on_angle = 89.9 * M_PI / 180.0;
+  EXPECT_EQ(band.evidence(), 0u);
 }
 
 // min_side_points: the normals of small segments (often fragments that range noise
 // cut out of one surface) do not tell two surfaces apart; a depth jump still does.
 TEST(RegionsOfInterest, SmallSegmentsMakeNoTwoSurfacesWithMinSidePoints)
 {
-  GridMesh g = makeGrid(10, 8, 0.01, 3, {4, 7}); // two segments of 40 points
-  RegionOfInterestParameters p;
-  p.sparse_factor = 0.0;
-  p.small_segment_points = 0;
-  p.max_window_size = 1.0;
-  p.min_side_angle = 25.0 * M_PI / 180.0;
-  const auto evidence = [&]() {
-    std::vector<RegionOfInterest> regions;
-    RegionOfInterestStats stats;
-    EXPECT_TRUE(computeRegionsOfInterest(
-        g.result, g.tri, Eigen::Affine3f::Identity(), p, regions, &stats));
-    return stats.transition_vertices;
-  };
-  // Normals 30 deg apart: a crease between segments of 40 points.
-  g.result.segments[0].normal = Eigen::Vector3f(0.0f, 0.0f, -1.0f);
-  g.result.segments[1].normal =
-      Eigen::Vector3f(0.0f, static_cast<float>(-std::sin(M_PI / 6)), -0.866025f);
-  EXPECT_EQ(evidence(), 20u);
-  p.min_side_points = 40;
-  EXPECT_EQ(evidence(), 20u);
-  p.min_side_points = 41; // both sides must hold as many
-  EXPECT_EQ(evidence(), 0u);
-  g.result.segments[0].num_points = 1000;
-  EXPECT_EQ(evidence(), 0u);
-  // The same band seen edge-on (segment 2 pushed 2 m back): a depth jump, whatever
-  // the segments' sizes.
-  for (std::size_t v = 0; v < g.tri.vertex_positions.size(); ++v)
-    if (g.result.labels[g.tri.vertex_point[v]] == 2)
-      g.tri.vertex_positions[v] *= 3.0f;
-  EXPECT_EQ(evidence(), 20u);
+  CreaseBand band;
+  band.setCrease(30.0); // a crease between segments of 40 points
+  EXPECT_EQ(band.evidence(), 20u);
+  band.p.min_side_points = 40;
+  EXPECT_EQ(band.evidence(), 20u);
+  band.p.min_side_points = 41; // both sides must hold as many
+  EXPECT_EQ(band.evidence(), 0u);
+  band.g.result.segments[0].num_points = 1000;
+  EXPECT_EQ(band.evidence(), 0u);
+  band.makeDepthJump(); // whatever the segments' sizes
+  EXPECT_EQ(band.evidence(), 20u);
 }
 
 // Fisher's cone of confidence, by hand: two unit vectors 2 deg apart have R = 2 cos 1
@@ -373,54 +380,30 @@ TEST(RegionsOfInterest, FisherConfidenceAngleKnownValues)
 // together; noisy facets widen the cone and the crease is no longer evidence.
 TEST(RegionsOfInterest, UncertainSegmentNormalsMakeNoTwoSurfaces)
 {
-  GridMesh g = makeGrid(10, 8, 0.01, 3, {4, 7});
-  RegionOfInterestParameters p;
-  p.sparse_factor = 0.0;
-  p.small_segment_points = 0;
-  p.max_window_size = 1.0;
-  p.min_side_angle = 25.0 * M_PI / 180.0;
-  p.side_confidence = 0.95;
-  const auto evidence = [&]() {
-    std::vector<RegionOfInterest> regions;
-    RegionOfInterestStats stats;
-    EXPECT_TRUE(computeRegionsOfInterest(
-        g.result, g.tri, Eigen::Affine3f::Identity(), p, regions, &stats));
-    return stats.transition_vertices;
-  };
-  g.result.segments[0].normal = Eigen::Vector3f(0.0f, 0.0f, -1.0f);
-  g.result.segments[1].normal =
-      Eigen::Vector3f(0.0f, static_cast<float>(-std::sin(M_PI / 6)), -0.866025f);
+  CreaseBand band;
+  band.p.side_confidence = 0.95;
+  band.setCrease(30.0);
   // Both segments planar (54 facets each, all with one normal): cones of 0.
-  EXPECT_EQ(evidence(), 20u);
+  EXPECT_EQ(band.evidence(), 20u);
   // Every other row of segment 2 pushed back along its rays by 1 cm (rows 1 cm apart
   // at 1 m): its 54 facets tilt by about 45 deg to either side, a cone of about
   // 11 deg.
-  const auto bump = [&](float depth) {
-    for (std::size_t v = 0; v < g.tri.vertex_positions.size(); ++v)
-      if (g.result.labels[g.tri.vertex_point[v]] == 2 && (v % 8) % 2 == 1)
-        g.tri.vertex_positions[v] *= 1.0f + depth;
-  };
-  bump(0.01f);
-  EXPECT_EQ(evidence(), 0u);
-  p.side_confidence = 0.0; // off: the plain comparison of the normals
-  EXPECT_EQ(evidence(), 20u);
+  const auto odd_rows = [](std::size_t v) { return (v % 8) % 2 == 1; };
+  band.pushBack(1.01f, odd_rows);
+  EXPECT_EQ(band.evidence(), 0u);
+  band.p.side_confidence = 0.0; // off: the plain comparison of the normals
+  EXPECT_EQ(band.evidence(), 20u);
   // A bump a hundred times smaller (facets tilted by 0.6 deg): a cone of a tenth of a
   // degree, the crease counts again.
-  p.side_confidence = 0.95;
-  bump(-0.01f / 1.01f);
-  bump(0.0001f);
-  EXPECT_EQ(evidence(), 20u);
-  // Seen edge-on (segment 2 pushed 2 m back), the band is a depth jump whatever the
-  // cones.
-  bump(0.3f);
-  for (std::size_t v = 0; v < g.tri.vertex_positions.size(); ++v)
-    if (g.result.labels[g.tri.vertex_point[v]] == 2)
-      g.tri.vertex_positions[v] *= 3.0f;
-  EXPECT_EQ(evidence(), 20u);
-  p.side_confidence = 1.0;
+  band.p.side_confidence = 0.95;
+  band.pushBack(1.0001f / 1.01f, odd_rows);
+  EXPECT_EQ(band.evidence(), 20u);
+  band.makeDepthJump(); // whatever the cones
+  EXPECT_EQ(band.evidence(), 20u);
+  band.p.side_confidence = 1.0;
   std::vector<RegionOfInterest> regions;
   EXPECT_FALSE(computeRegionsOfInterest(
-      g.result, g.tri, Eigen::Affine3f::Identity(), p, regions));
+      band.g.result, band.g.tri, Eigen::Affine3f::Identity(), band.p, regions));
 }
 
 // use_edge_on: a depth jump inside one segment (two surfaces at different depths
