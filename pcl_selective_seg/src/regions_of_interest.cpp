@@ -225,6 +225,24 @@ markLeafEvidence(const SegmentationResult& result,
       kinds[v] |= kTransition;
 }
 
+/** Corners of triangle \a t in the sensor frame. */
+std::array<Eigen::Vector3d, 3>
+sensorCorners(const SphericalTriangulation& tri, std::size_t t)
+{
+  const auto& corners = tri.triangles[t];
+  return {tri.vertex_positions[corners[0]].cast<double>(),
+          tri.vertex_positions[corners[1]].cast<double>(),
+          tri.vertex_positions[corners[2]].cast<double>()};
+}
+
+/** Unnormalized normal of triangle \a t (counter-clockwise in (theta, phi)) from its
+ * sensor-frame corners \a x. */
+Eigen::Vector3d
+crossNormal(const std::array<Eigen::Vector3d, 3>& x)
+{
+  return (x[1] - x[0]).cross(x[2] - x[0]);
+}
+
 /** Whether triangle \a t is seen edge-on: more than edge_on_angle between its normal
  * and the line of sight to its centroid (the sensor is at the origin of the sensor
  * frame); a degenerate triangle counts as edge-on when \a degenerate is true. */
@@ -234,12 +252,9 @@ edgeOn(const SphericalTriangulation& tri,
        const RegionOfInterestParameters& p,
        bool degenerate = true)
 {
-  const auto& corners = tri.triangles[t];
-  const Eigen::Vector3d a = tri.vertex_positions[corners[0]].cast<double>();
-  const Eigen::Vector3d b = tri.vertex_positions[corners[1]].cast<double>();
-  const Eigen::Vector3d c = tri.vertex_positions[corners[2]].cast<double>();
-  const Eigen::Vector3d normal = (b - a).cross(c - a);
-  const Eigen::Vector3d ray = a + b + c;
+  const auto x = sensorCorners(tri, t);
+  const Eigen::Vector3d normal = crossNormal(x);
+  const Eigen::Vector3d ray = x[0] + x[1] + x[2];
   const double n = normal.norm() * ray.norm();
   if (!(n > 0.0) || !std::isfinite(n))
     return degenerate;
@@ -260,21 +275,20 @@ sideCones(const SegmentationResult& result,
   const std::size_t ns = result.segments.size();
   std::vector<Eigen::Vector3d> sum(ns, Eigen::Vector3d::Zero());
   std::vector<std::size_t> count(ns, 0);
-  for (const auto& corners : tri.triangles) {
+  for (std::size_t t = 0; t < tri.triangles.size(); ++t) {
+    const auto& corners = tri.triangles[t];
     const std::uint32_t label = result.labels[tri.vertex_point[corners[0]]];
     if (label == 0 || label > ns ||
         result.labels[tri.vertex_point[corners[1]]] != label ||
         result.labels[tri.vertex_point[corners[2]]] != label)
       continue;
-    const Eigen::Vector3d a = tri.vertex_positions[corners[0]].cast<double>();
-    const Eigen::Vector3d b = tri.vertex_positions[corners[1]].cast<double>();
-    const Eigen::Vector3d c = tri.vertex_positions[corners[2]].cast<double>();
-    Eigen::Vector3d n = (b - a).cross(c - a);
+    const auto x = sensorCorners(tri, t);
+    Eigen::Vector3d n = crossNormal(x);
     const double length = n.norm();
     if (!(length > 0.0) || !std::isfinite(length))
       continue;
     n /= length;
-    sum[label - 1] += n.dot(a) > 0.0 ? -n : n; // toward the sensor at the origin
+    sum[label - 1] += n.dot(x[0]) > 0.0 ? -n : n; // toward the sensor at the origin
     ++count[label - 1];
   }
   std::vector<double> cones(ns);
