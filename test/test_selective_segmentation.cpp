@@ -23,6 +23,10 @@
 
 #include <cube_scene.h>
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 using pcl::selective_seg::SegmentationResult;
 using pcl::selective_seg::SelectiveSegmentation;
 using Labeled = pcl::PointCloud<pcl::PointXYZL>;
@@ -142,6 +146,44 @@ TEST(SelectiveSegmentation, ShuffledInputGivesIdenticalSegments)
   for (std::size_t k = 0; k < perm.size(); ++k)
     ASSERT_EQ(a.getResult().labels[perm[k]], b.getResult().labels[k]) << k;
   EXPECT_EQ(a.getResult().leaves.size(), b.getResult().leaves.size());
+}
+
+TEST(SelectiveSegmentation, AutomaticThreadsFollowOpenMP)
+{
+#ifdef _OPENMP
+  using pcl::selective_seg::defaultThreads;
+  const int saved_threads = omp_get_max_threads();
+  const int saved_levels = omp_get_max_active_levels();
+  // What OMP_NUM_THREADS sets, and not the machine's core count.
+  omp_set_num_threads(3);
+  EXPECT_EQ(defaultThreads(), 3u);
+  omp_set_num_threads(1);
+  EXPECT_EQ(defaultThreads(), 1u);
+  // Called from a thread of the caller's own team, which cannot nest: one thread (the
+  // parallel stages would not fork either).
+  omp_set_num_threads(2);
+  omp_set_max_active_levels(1);
+  std::vector<unsigned int> inside(2, 0);
+#pragma omp parallel num_threads(2)
+  inside[static_cast<std::size_t>(omp_get_thread_num())] = defaultThreads();
+  EXPECT_EQ(inside[0], 1u);
+  EXPECT_EQ(inside[1], 1u);
+  // num_threads = 0 in the parameters takes it too; the result does not change.
+  const auto cloud = cubeScene(20000, 3);
+  std::vector<std::vector<std::uint32_t>> labels;
+  for (const int threads : {1, 2}) {
+    omp_set_num_threads(threads);
+    SelectiveSegmentation<pcl::PointXYZL> seg;
+    std::vector<pcl::PointIndices> clusters;
+    ASSERT_TRUE(segment<pcl::PointXYZL>(cloud, seg, clusters));
+    labels.push_back(seg.getResult().labels);
+  }
+  EXPECT_EQ(labels[0], labels[1]);
+  omp_set_num_threads(saved_threads);
+  omp_set_max_active_levels(saved_levels);
+#else
+  GTEST_SKIP() << "built without OpenMP: the library runs on one thread";
+#endif
 }
 
 TEST(SelectiveSegmentation, ThreadCountDoesNotChangeTheResult)

@@ -16,8 +16,10 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <string>
+
 #include <sys/wait.h>
 
 namespace fs = std::filesystem;
@@ -168,9 +170,23 @@ TEST_F(Tool, BadOptionsAreUsageErrors)
   EXPECT_EQ(run(in + " -no_such_option"), 2);
   EXPECT_EQ(run(in + " -sensor_origin 1,2"), 2);
   EXPECT_EQ(run(in + " -unit_scale 0"), 2);
+  EXPECT_EQ(run(in + " -threads -1"), 2);
   EXPECT_EQ(run(""), 2);
   EXPECT_EQ(run("-h"), 0);
   EXPECT_EQ(files(), 0u);
+}
+
+TEST_F(Tool, ThreadCountKeepsTheOutput)
+{
+  const std::string in = "'" + scan + "' -ignore_viewpoint -o ";
+  ASSERT_EQ(run(in + out("one.pcd") + " -threads 1"), 0);
+  ASSERT_EQ(run(in + out("two.pcd") + " -threads 2"), 0);
+  std::ifstream one(out("one.pcd"), std::ios::binary),
+      two(out("two.pcd"), std::ios::binary);
+  const std::string a((std::istreambuf_iterator<char>(one)), {});
+  const std::string b((std::istreambuf_iterator<char>(two)), {});
+  EXPECT_GT(a.size(), 1000u);
+  EXPECT_EQ(a, b);
 }
 
 TEST_F(Tool, UnwritableOutputLeavesNothingBehind)

@@ -68,7 +68,8 @@ segmentationFlags()
                                                  "-max_depth",
                                                  "-angle_step_rad",
                                                  "-min_split_points",
-                                                 "-backend"};
+                                                 "-backend",
+                                                 "-threads"};
   return flags;
 }
 
@@ -114,6 +115,10 @@ printSegmentationHelp()
              d.angle_quantization);
   print_info(
       "  -backend NAME          Delaunay backend: sweep, boost or vtk (default sweep)\n");
+  print_info("  -threads N             threads of the parallel stages; 0 = automatic: "
+             "OMP_NUM_THREADS, else the CPUs the process may use (default %d; the "
+             "result does not depend on it)\n",
+             d.num_threads);
 }
 
 bool
@@ -129,6 +134,7 @@ parseSegmentationOptions(int argc, char** argv, SelectiveSegmentationParameters&
       !parseNumber(argc, argv, "-min_split_points", p.min_points_to_split) ||
       !parseNumber(argc, argv, "-max_depth", p.max_octree_depth) ||
       !parseNumber(argc, argv, "-angle_step_rad", p.angle_quantization) ||
+      !parseNumber(argc, argv, "-threads", p.num_threads) ||
       !parseChoice(argc,
                    argv,
                    "-segment_weight",
@@ -147,14 +153,13 @@ parseSegmentationOptions(int argc, char** argv, SelectiveSegmentationParameters&
                    {{"facet", EdgeTriangleNormal::Facet},
                     {"vertex_mean", EdgeTriangleNormal::VertexMean}},
                    p.edge_triangle_normal) ||
-      !parseChoice(
-          argc,
-          argv,
-          "-backend",
-          {{"boost", DelaunayBackend::BoostVoronoi},
+      !parseChoice(argc,
+                   argv,
+                   "-backend",
+                   {{"boost", DelaunayBackend::BoostVoronoi},
                     {"vtk", DelaunayBackend::Vtk},
                     {"sweep", DelaunayBackend::Sweep}},
-          p.delaunay_backend))
+                   p.delaunay_backend))
     return false;
   std::string why;
   if (!p.validate(&why)) {

@@ -24,7 +24,7 @@ namespace selective_seg {
 
 namespace {
 
-/** OpenMP thread count: 0 = all cores. */
+/** OpenMP thread count: 0 = defaultThreads(). */
 int
 threads(int requested)
 {

@@ -6,13 +6,31 @@
 
 #include <pcl_selective_seg/parameters.h>
 
-#include "parameter_checks.h"
-
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
+#include "parameter_checks.h"
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 namespace pcl {
 namespace selective_seg {
+
+unsigned int
+defaultThreads()
+{
+#ifdef _OPENMP
+  // Inside a caller's parallel region that cannot nest, a new team has one thread.
+  if (omp_get_active_level() >= omp_get_max_active_levels())
+    return 1u;
+  return static_cast<unsigned int>(std::max(1, omp_get_max_threads()));
+#else
+  return 1u;
+#endif
+}
 namespace {
 
 bool
@@ -57,7 +75,7 @@ SelectiveSegmentationParameters::validate(std::string* why) const
     return reject(
         why, "angle_quantization [rad]", angle_quantization, "[2.5e-8, 1e-2]");
   if (num_threads < 0 || num_threads > 1024)
-    return reject(why, "num_threads", num_threads, "[0, 1024], 0 = all cores");
+    return reject(why, "num_threads", num_threads, "[0, 1024], 0 = automatic");
   if (edge_triangle_normal != EdgeTriangleNormal::Facet &&
       edge_triangle_normal != EdgeTriangleNormal::VertexMean)
     return reject(why,

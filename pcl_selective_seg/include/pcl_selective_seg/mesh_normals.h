@@ -49,9 +49,8 @@ PCL_EXPORTS void computeTriangleNormals(const Vector3fVector& positions,
  * \param[out] vertex_normals #V unit normals; NaN where no valid triangle is incident
  *             or the weighted normals cancel
  * \param[out] vertex_areas #V areas A_p [m^2]
- * \param[in] num_threads OpenMP threads, 0 = all cores (the result does not depend on
- * it)
- * \param[in] neighbours optional: the adjacency of \a triangles
+ * \param[in] num_threads OpenMP threads, 0 = defaultThreads() (the result does not
+ * depend on it) \param[in] neighbours optional: the adjacency of \a triangles
  *            (computeTriangleNeighbours()). Each triangle's terms are added to its
  *            vertices in increasing triangle order: the same sums in the same order as
  *            gathering them per vertex, so the same bits. Large meshes are split among
@@ -111,7 +110,7 @@ computeTriangleNormalsFromVertices(const std::vector<Triangle>& triangles,
  * \param[in] viewpoint sensor origin [m]
  * \param[in] max_incidence [rad]; pi/2 or more flags only degenerate triangles
  * \param[out] edge_on #T 1 = seen edge-on
- * \param[in] num_threads OpenMP threads, 0 = all cores
+ * \param[in] num_threads OpenMP threads, 0 = defaultThreads()
  */
 PCL_EXPORTS void markEdgeOnTriangles(const Vector3fVector& positions,
                                      const std::vector<Triangle>& triangles,
@@ -186,7 +185,7 @@ updateVertexNormalsOverRings(const std::vector<Triangle>& triangles,
 /** \brief Median 3-D length of the triangles' edges [m] (each interior edge counted
  * twice; over 100,000 triangles, those of every stride-th triangle, stride =
  * triangles / 100,000); 0 for an empty mesh. The octree's automatic minimum voxel size
- * scales it. Threads: 0 = all cores; the result does not depend on them. */
+ * scales it. Threads: 0 = defaultThreads(); the result does not depend on them. */
 PCL_EXPORTS double medianEdgeLength(const Vector3fVector& positions,
                                     const std::vector<Triangle>& triangles,
                                     int num_threads = 1);

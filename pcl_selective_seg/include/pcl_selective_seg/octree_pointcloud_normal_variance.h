@@ -18,7 +18,6 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
-#include <thread>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -112,12 +111,11 @@ public:
   void setInputNormals(const NormalVectorsConstPtr& normals,
                        const AreasConstPtr& areas);
 
-  /** \brief Threads for the per-point work (0: all cores); the result does not
+  /** \brief Threads for the per-point work (0: defaultThreads()); the result does not
    * depend on it. */
   void setNumberOfThreads(unsigned int threads)
   {
-    num_threads_ =
-        threads ? threads : std::max(1u, std::thread::hardware_concurrency());
+    num_threads_ = threads ? threads : defaultThreads();
   }
 
   /** \brief Orientation of the sensor in the cloud frame (the angles of eq. 5 are
@@ -260,7 +258,7 @@ private:
   detail::ScratchVector<double> ordered_phi_;
   detail::ScratchVector<double> ordered_weights_; ///< 1 / A_p (eq. 4)
   std::vector<AdaptiveLeaf> leaves_;
-  unsigned int num_threads_ = std::max(1u, std::thread::hardware_concurrency());
+  unsigned int num_threads_ = defaultThreads();
 };
 
 } // namespace selective_seg

@@ -15,6 +15,13 @@
 namespace pcl {
 namespace selective_seg {
 
+/** \brief The threads a parallel stage uses when given 0 ("automatic"): the size of
+ * the team OpenMP would form, that is OMP_NUM_THREADS (or omp_set_num_threads()) when
+ * set, otherwise the processors this process may run on (its CPU affinity, as taskset
+ * or a container's cpuset leave it); 1 when called inside a parallel region of the
+ * caller's that cannot nest, or when the library was built without OpenMP. */
+PCL_EXPORTS unsigned int defaultThreads();
+
 /** \brief Which normal of a triangle eq. 8 compares with the segment normal. */
 enum class EdgeTriangleNormal : std::uint8_t {
   /** The facet normal, as in the paper. */
@@ -115,8 +122,8 @@ struct PCL_EXPORTS SelectiveSegmentationParameters {
    * Default 1e-7 rad (0.1 micrometre at 1 m). Valid: [2.5e-8, 1e-2]. */
   double angle_quantization = 1e-7;
 
-  /** \brief Threads for the parallel stages; 0 = all cores. The result is identical
-   * for any value. Valid: [0, 1024]. */
+  /** \brief Threads for the parallel stages; 0 = automatic (defaultThreads()). The
+   * result is identical for any value. Valid: [0, 1024]. */
   int num_threads = 0;
 
   /** \brief Triangulation backend. Default: Sweep, our exact scan-order triangulator

@@ -39,7 +39,7 @@ struct MergeInput {
   SegmentNormalWeight segment_normal_weight = SegmentNormalWeight::InverseArea;
   double max_edge_triangle_angle = 0.0; ///< eq. 8 threshold [rad]
   /** Threads for building the incidence lists and for growing seeds ahead of their
-   * turn (0: all cores). The result does not depend on it. */
+   * turn (0: defaultThreads()). The result does not depend on it. */
   int num_threads = 1;
 };
 
@@ -84,7 +84,8 @@ PCL_EXPORTS void mergeSeedSegments(const MergeInput& input,
  * \param[in] max_edge_triangle_angle [rad]
  * \param[out] labels #T labels (0 when no vertex is labeled)
  * \param[out] classes #T classes
- * \param[in] num_threads threads (0: all cores); the result does not depend on it
+ * \param[in] num_threads threads (0: defaultThreads()); the result does not depend on
+ * it
  */
 PCL_EXPORTS void classifyTriangles(const std::vector<Triangle>& triangles,
                                    const Vector3fVector& triangle_normals,
@@ -111,14 +112,16 @@ struct PCL_EXPORTS Incidence {
 /** \brief The points of each label: clusters[l - 1].indices lists the i with labels[i]
  * == l, in increasing order, for l = 1 .. num_labels (label 0, and labels above
  * num_labels, are left out). Headers are left as they are.
- * \param[in] num_threads threads (0: all cores); the result does not depend on it */
+ * \param[in] num_threads threads (0: defaultThreads()); the result does not depend on
+ * it */
 PCL_EXPORTS void clustersFromLabels(const std::vector<std::uint32_t>& labels,
                                     std::size_t num_labels,
                                     std::vector<pcl::PointIndices>& clusters,
                                     int num_threads = 1);
 
 /** \brief Triangles at each vertex, in increasing triangle order.
- * \param[in] num_threads threads (0: all cores); the result does not depend on it */
+ * \param[in] num_threads threads (0: defaultThreads()); the result does not depend on
+ * it */
 PCL_EXPORTS Incidence vertexTriangles(const std::vector<Triangle>& triangles,
                                       std::size_t num_vertices,
                                       int num_threads = 1);

@@ -260,7 +260,8 @@ protected:
   /** \brief The triangle normals eq. 8 tests (parameter edge_triangle_normal). */
   const Vector3fVector& edgeTestNormals();
 
-  /** \brief Threads of the parallel loops (parameter num_threads, 0 = all cores). */
+  /** \brief Threads of the parallel loops (parameter num_threads, 0 =
+   * defaultThreads()). */
   int numThreads() const
   {
     return params_.num_threads > 0 ? params_.num_threads

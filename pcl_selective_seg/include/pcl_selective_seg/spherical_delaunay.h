@@ -8,23 +8,16 @@
 
 #include <pcl_selective_seg/delaunay_2d.h>
 #include <pcl_selective_seg/delaunay_2d_update.h>
+#include <pcl_selective_seg/parameters.h>
 
 #include <Eigen/Geometry>
 #include <pcl/surface/reconstruction.h>
 
 #include <algorithm>
-#include <thread>
 #include <vector>
 
 namespace pcl {
 namespace selective_seg {
-
-/** \brief The number of hardware threads, at least 1. */
-inline unsigned int
-defaultThreads()
-{
-  return std::max(1u, std::thread::hardware_concurrency());
-}
 
 namespace detail {
 
@@ -118,8 +111,8 @@ public:
   void setAngleQuantization(double step) { angle_quantization_ = step; }
   double getAngleQuantization() const { return angle_quantization_; }
 
-  /** \brief Threads for the projection (0: all cores). The result does not depend on
-   * it. */
+  /** \brief Threads for the projection (0: defaultThreads()). The result does not
+   * depend on it. */
   void setNumberOfThreads(unsigned int threads)
   {
     num_threads_ = threads ? threads : defaultThreads();
