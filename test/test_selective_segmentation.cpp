@@ -192,11 +192,10 @@ TEST(SelectiveSegmentation, ThreadCountDoesNotChangeTheResult)
   const auto cloud = cubeScene(80000, 8);
   std::vector<SegmentationResult> results;
   std::vector<std::vector<pcl::PointIndices>> all_clusters;
-  for (const int threads : {1, 2, 3}) {
+  for (const unsigned int threads : {1u, 2u, 3u}) {
     SelectiveSegmentation<pcl::PointXYZL> seg;
-    auto p = seg.getParameters();
-    p.num_threads = threads;
-    seg.setParameters(p);
+    seg.setNumberOfThreads(threads); // PCL's name for the num_threads parameter
+    ASSERT_EQ(seg.getParameters().num_threads, static_cast<int>(threads));
     std::vector<pcl::PointIndices> clusters;
     ASSERT_TRUE(segment<pcl::PointXYZL>(cloud, seg, clusters));
     results.push_back(seg.getResult());

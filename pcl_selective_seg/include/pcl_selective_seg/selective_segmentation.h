@@ -17,6 +17,7 @@
 #include <pcl/pcl_base.h>
 #include <pcl/point_types.h>
 
+#include <algorithm>
 #include <vector>
 
 namespace pcl {
@@ -138,6 +139,18 @@ public:
     params_.delaunay_backend = backend;
   }
   DelaunayBackend getDelaunayBackend() const { return params_.delaunay_backend; }
+
+  /** \brief Threads of the parallel stages, as PCL's OpenMP classes take them: 0 =
+   * automatic (defaultThreads(): OMP_NUM_THREADS, else the CPUs the process may use).
+   * The result does not depend on it; extract() refuses more than 1,024. */
+  void setNumberOfThreads(unsigned int nr_threads = 0)
+  {
+    params_.num_threads = static_cast<int>(std::min(nr_threads, 1u << 30));
+  }
+  unsigned int getNumberOfThreads() const
+  {
+    return static_cast<unsigned int>(params_.num_threads);
+  }
 
   /** \brief Sensor pose in the cloud frame (the sensor looks along its +z axis),
    * overriding the cloud's sensor_origin_ / sensor_orientation_. */
