@@ -7,6 +7,10 @@ function(run)
 endfunction()
 file(REMOVE_RECURSE ${PREFIX} ${WORK_DIR})
 run(${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${PREFIX})
+# The licence goes with the package (BSD-3-Clause: binaries must carry the notice).
+if(NOT EXISTS ${PREFIX}/share/doc/pcl_selective_seg/LICENSE)
+  message(FATAL_ERROR "LICENSE not installed to ${PREFIX}/share/doc/pcl_selective_seg")
+endif()
 run(${CMAKE_COMMAND} -S ${SOURCE_DIR} -B ${WORK_DIR} -DCMAKE_PREFIX_PATH=${PREFIX}
     -DCMAKE_BUILD_TYPE=Release)
 run(${CMAKE_COMMAND} --build ${WORK_DIR} -j2)
