@@ -23,6 +23,19 @@
 namespace pcl {
 namespace selective_seg {
 
+/** \brief What the last SelectiveSegmentation::update() changed. */
+struct UpdateStatistics {
+  /** The mesh and normals were updated in place; false: the pipeline ran from scratch
+   * on the union (no mesh to update, or parameters or sensor pose changed since). */
+  bool incremental = false;
+  std::size_t new_points = 0;     ///< points given to update()
+  std::size_t new_vertices = 0;   ///< mesh vertices they added
+  std::size_t moved_vertices = 0; ///< vertices now represented by a nearer new point
+  std::size_t replaced_triangles = 0; ///< old triangles the insertion replaced
+  std::size_t new_triangles = 0;      ///< triangles not in the old mesh
+  std::size_t changed_vertices = 0;   ///< vertices whose normal was recomputed
+};
+
 /** \brief Segmentation of a 3-D surface point cloud seen from one sensor viewpoint into
  * surface segments, for selective sensing.
  *
@@ -34,13 +47,15 @@ namespace selective_seg {
  * normal angles exceeds a threshold (eq. 3-5), (5) every octree leaf a seed segment,
  * seeds merged across the mesh when their normals agree (eq. 6-10).
  *
- * Usage, as any PCL segmentation:
+ * Usage, as any PCL segmentation (the sensor pose is the cloud's sensor_origin_ and
+ * sensor_orientation_, or setSensorPose()):
  * \code
  * pcl::selective_seg::SelectiveSegmentation<pcl::PointXYZ> seg;
- * seg.setInputCloud(cloud);            // sensor pose:
- * cloud->sensor_origin_/orientation_ std::vector<pcl::PointIndices> segments; if
- * (seg.extract(segments))           // largest first auto labeled =
- * seg.getLabeledCloud(); \endcode
+ * seg.setInputCloud(cloud);
+ * std::vector<pcl::PointIndices> segments;  // largest first
+ * if (seg.extract(segments))
+ *   auto labeled = seg.getLabeledCloud();   // pcl::PointXYZL, input layout
+ * \endcode
  *
  * Points outside the indices, with non-finite coordinates, at or behind the sensor
  * plane or without a normal get label 0 and are counted in getResult().counts. The
@@ -51,19 +66,6 @@ namespace selective_seg {
  * are reported in the cloud frame. The octree's voxels are aligned with the sensor
  * axes.
  */
-/** \brief What the last SelectiveSegmentation::update() changed. */
-struct UpdateStatistics {
-  /** The mesh and normals were updated in place; false: the pipeline ran from scratch
-   * on the union (no mesh to update, or parameters or sensor pose changed since). */
-  bool incremental = false;
-  std::size_t new_points = 0;         ///< points given to update()
-  std::size_t new_vertices = 0;       ///< mesh vertices they added
-  std::size_t moved_vertices = 0;     ///< vertices now represented by a nearer new point
-  std::size_t replaced_triangles = 0; ///< old triangles the insertion replaced
-  std::size_t new_triangles = 0;      ///< triangles not in the old mesh
-  std::size_t changed_vertices = 0;   ///< vertices whose normal was recomputed
-};
-
 template <typename PointT> class SelectiveSegmentation : public pcl::PCLBase<PointT> {
 public:
   using Ptr = pcl::shared_ptr<SelectiveSegmentation<PointT>>;
@@ -176,8 +178,8 @@ public:
    * (given in the same frame as the input; unorganized, height 1). With indices set,
    * the new points' indices are appended to them. The finest voxel size of the run
    * being updated is kept, so the result is that of extract() on the union with
-   * setMinVoxelSize(getResult().min_voxel_size) (see docs/selective_sensing.md for
-   * what is recomputed and how closely it matches).
+   * setMinVoxelSize(getResult().min_voxel_size), bit for bit
+   * (docs/incremental_update.md: what is recomputed, and when it runs from scratch).
    * \param[in] new_points the points to add
    * \param[out] clusters as extract(), over the union
    * \return as extract(); false also when there is no result to update. */
@@ -186,8 +188,8 @@ public:
   /** \brief What the last update() changed. */
   const UpdateStatistics& getUpdateStatistics() const { return update_stats_; }
 
-  /** \brief Labels, segments, leaves, mesh, counts and timings of the last extract().
-   */
+  /** \brief Labels, segments, leaves, mesh, counts and timings of the last extract()
+   * or update(). */
   const SegmentationResult& getResult() const { return result_; }
 
   /** \brief The input's points with their labels (0 = unlabeled); same size, order
@@ -297,7 +299,7 @@ private:
   SphericalDelaunay<PointT> delaunay_;
   typename Octree::Ptr octree_;
   mutable NormalCloud::ConstPtr normals_; ///< built by getPointNormals()
-  Vector3fVector vertex_normals_; ///< sensor frame
+  Vector3fVector vertex_normals_;         ///< sensor frame
   std::shared_ptr<std::vector<double>> vertex_areas_;
   Vector3fVector triangle_normals_;
   std::vector<double> triangle_areas_;
