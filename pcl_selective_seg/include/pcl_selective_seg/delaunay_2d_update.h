@@ -18,11 +18,11 @@ namespace selective_seg {
 
 /** \brief How insertDelaunayPoints() renumbered and changed a triangulation. */
 struct DelaunayInsertion {
-  /** #V_old new id of each old point. Increasing: the old points keep their order. */
+  /** \#V_old new id of each old point. Increasing: the old points keep their order. */
   std::vector<pcl::index_t> old_to_new_point;
   /** New ids of the inserted points, increasing. */
   std::vector<pcl::index_t> inserted_points;
-  /** #T_old new id of each old triangle, or -1 for one that the insertion replaced. */
+  /** \#T_old new id of each old triangle, or -1 for one that the insertion replaced. */
   std::vector<pcl::index_t> old_to_new_triangle;
   /** New ids of the triangles that were not in the old triangulation, increasing. */
   std::vector<pcl::index_t> new_triangles;

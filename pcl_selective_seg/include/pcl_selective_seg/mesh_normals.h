@@ -22,12 +22,12 @@ using Vector3fVector = std::vector<Eigen::Vector3f>;
 
 /** \brief Unit normal and 3-D area of each triangle (paper, Sec. III.B).
  *
- * \param[in] positions #V vertex positions [m]
- * \param[in] triangles #T triangles over vertex ids
+ * \param[in] positions \#V vertex positions [m]
+ * \param[in] triangles \#T triangles over vertex ids
  * \param[in] viewpoint sensor origin in the frame of \a positions [m]; each normal is
  *            oriented toward it (n . (centroid - viewpoint) <= 0)
- * \param[out] normals #T unit normals; NaN for a degenerate (zero-area) triangle
- * \param[out] areas #T areas A_t [m^2], computed in double precision (finite for any
+ * \param[out] normals \#T unit normals; NaN for a degenerate (zero-area) triangle
+ * \param[out] areas \#T areas A_t [m^2], computed in double precision (finite for any
  *             finite float input)
  */
 PCL_EXPORTS void computeTriangleNormals(const Vector3fVector& positions,
@@ -42,13 +42,13 @@ PCL_EXPORTS void computeTriangleNormals(const Vector3fVector& positions,
  * N_p = normalize(sum over incident triangles t of N_t / A_t); triangles with zero or
  * non-finite area or normal are skipped. A_p = sum of A_t over the incident triangles.
  *
- * \param[in] num_vertices #V
- * \param[in] triangles #T triangles over vertex ids
- * \param[in] normals #T triangle normals, from computeTriangleNormals()
- * \param[in] areas #T triangle areas [m^2]
- * \param[out] vertex_normals #V unit normals; NaN where no valid triangle is incident
+ * \param[in] num_vertices \#V
+ * \param[in] triangles \#T triangles over vertex ids
+ * \param[in] normals \#T triangle normals, from computeTriangleNormals()
+ * \param[in] areas \#T triangle areas [m^2]
+ * \param[out] vertex_normals \#V unit normals; NaN where no valid triangle is incident
  *             or the weighted normals cancel
- * \param[out] vertex_areas #V areas A_p [m^2]
+ * \param[out] vertex_areas \#V areas A_p [m^2]
  * \param[in] num_threads OpenMP threads, 0 = defaultThreads() (the result does not
  * depend on it) \param[in] neighbours optional: the adjacency of \a triangles
  *            (computeTriangleNeighbours()). Each triangle's terms are added to its
@@ -76,12 +76,12 @@ PCL_EXPORTS void computeVertexNormals(std::size_t num_vertices,
  * of N_t / A_t). rings = 1 is eq. 2 exactly. The 1 / area weights keep triangles that
  * span depth jumps (huge in 3-D) from blurring the normals across occlusion edges.
  *
- * \param[in] num_vertices #V
- * \param[in] triangles #T triangles over vertex ids
- * \param[in] normals #T triangle normals
- * \param[in] areas #T triangle areas [m^2]
+ * \param[in] num_vertices \#V
+ * \param[in] triangles \#T triangles over vertex ids
+ * \param[in] normals \#T triangle normals
+ * \param[in] areas \#T triangle areas [m^2]
  * \param[in] rings k >= 1
- * \param[out] vertex_normals #V unit normals; NaN where no valid triangle is found
+ * \param[out] vertex_normals \#V unit normals; NaN where no valid triangle is found
  */
 PCL_EXPORTS void computeVertexNormalsOverRings(std::size_t num_vertices,
                                                const std::vector<Triangle>& triangles,
@@ -91,9 +91,9 @@ PCL_EXPORTS void computeVertexNormalsOverRings(std::size_t num_vertices,
                                                Vector3fVector& vertex_normals);
 
 /** \brief Triangle normals as the normalized mean of their vertices' normals.
- * \param[in] triangles #T triangles over vertex ids
- * \param[in] vertex_normals #V unit normals (NaN: no normal)
- * \param[out] normals #T unit normals; NaN when a vertex has none or they cancel */
+ * \param[in] triangles \#T triangles over vertex ids
+ * \param[in] vertex_normals \#V unit normals (NaN: no normal)
+ * \param[out] normals \#T unit normals; NaN when a vertex has none or they cancel */
 PCL_EXPORTS void
 computeTriangleNormalsFromVertices(const std::vector<Triangle>& triangles,
                                    const Vector3fVector& vertex_normals,
@@ -104,12 +104,12 @@ computeTriangleNormalsFromVertices(const std::vector<Triangle>& triangles,
  * A triangle whose normal makes more than \a max_incidence with the line of sight to
  * its centroid spans a depth discontinuity rather than a surface.
  *
- * \param[in] positions #V vertex positions [m]
- * \param[in] triangles #T triangles
- * \param[in] normals #T unit normals (NaN: degenerate, flagged)
+ * \param[in] positions \#V vertex positions [m]
+ * \param[in] triangles \#T triangles
+ * \param[in] normals \#T unit normals (NaN: degenerate, flagged)
  * \param[in] viewpoint sensor origin [m]
  * \param[in] max_incidence [rad]; pi/2 or more flags only degenerate triangles
- * \param[out] edge_on #T 1 = seen edge-on
+ * \param[out] edge_on \#T 1 = seen edge-on
  * \param[in] num_threads OpenMP threads, 0 = defaultThreads()
  */
 PCL_EXPORTS void markEdgeOnTriangles(const Vector3fVector& positions,
@@ -136,11 +136,11 @@ PCL_EXPORTS void computeTriangleNormalsAndEdgeOn(const Vector3fVector& positions
  * values of the kept triangles are moved from the old arrays, those of the triangles in
  * \a changed computed again.
  *
- * \param[in] old_to_new #T_old new id of each old triangle, -1 if it is gone
+ * \param[in] old_to_new \#T_old new id of each old triangle, -1 if it is gone
  * \param[in] changed new ids of the triangles to compute (the new triangles and any
  *            whose corners moved); every other new triangle must have an old one
- * \param[in,out] normals,areas,edge_on on input the old arrays (#T_old), on output the
- *                new ones (#T), as computeTriangleNormalsAndEdgeOn() gives them */
+ * \param[in,out] normals,areas,edge_on on input the old arrays (\#T_old), on output the
+ *                new ones (\#T), as computeTriangleNormalsAndEdgeOn() gives them */
 PCL_EXPORTS void updateTriangleNormalsAndEdgeOn(const Vector3fVector& positions,
                                                 const std::vector<Triangle>& triangles,
                                                 const Eigen::Vector3f& viewpoint,

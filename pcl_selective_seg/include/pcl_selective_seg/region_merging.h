@@ -21,17 +21,18 @@ namespace selective_seg {
 
 /** \brief Inputs of the seed merging (paper, Sec. III.D), as parallel arrays. */
 struct MergeInput {
-  const Vector3fVector* leaf_normals = nullptr; ///< #L unit voxel normals N_v (eq. 4)
-  const std::vector<double>* leaf_areas = nullptr; ///< #L voxel areas A_v (eq. 6) [m^2]
+  const Vector3fVector* leaf_normals = nullptr; ///< \#L unit voxel normals N_v (eq. 4)
+  /** \#L voxel areas A_v (eq. 6) [m^2] */
+  const std::vector<double>* leaf_areas = nullptr;
   /** Instead of leaf_normals and leaf_areas (then unused): the octree's leaves, whose
    * normal and area fields are read in place. */
   const std::vector<AdaptiveLeaf>* leaves = nullptr;
   const std::vector<pcl::index_t>* vertex_leaf =
-      nullptr; ///< #V leaf of each vertex, -1: none
-  const std::vector<Triangle>* triangles = nullptr; ///< #T triangles over vertex ids
+      nullptr; ///< \#V leaf of each vertex, -1: none
+  const std::vector<Triangle>* triangles = nullptr; ///< \#T triangles over vertex ids
   const Vector3fVector* triangle_normals =
-      nullptr; ///< #T unit normals, NaN if degenerate
-  /** #T optional: 1 for a triangle seen edge-on (a depth discontinuity), never valid.
+      nullptr; ///< \#T unit normals, NaN if degenerate
+  /** \#T optional: 1 for a triangle seen edge-on (a depth discontinuity), never valid.
    */
   const std::vector<std::uint8_t>* triangle_edge_on = nullptr;
   double max_merge_angle = 0.0;         ///< eq. 9 threshold [rad]
@@ -62,8 +63,8 @@ struct MergeInput {
  * (docs/performance.md, "Round 6").
  *
  * \param[in] input the seeds and the mesh
- * \param[out] leaf_segment #L segment id of each seed, 0..#S-1 in creation order
- * \param[out] segment_normals #S unit segment normals N_S (eq. 7)
+ * \param[out] leaf_segment \#L segment id of each seed, 0..#S-1 in creation order
+ * \param[out] segment_normals \#S unit segment normals N_S (eq. 7)
  */
 PCL_EXPORTS void mergeSeedSegments(const MergeInput& input,
                                    std::vector<pcl::index_t>& leaf_segment,
@@ -76,14 +77,14 @@ PCL_EXPORTS void mergeSeedSegments(const MergeInput& input,
  * valid edge when that angle is at most max_edge_triangle_angle and it is not seen
  * edge-on, an invalid edge otherwise.
  *
- * \param[in] triangles #T triangles over vertex ids
- * \param[in] triangle_normals #T unit normals (NaN: degenerate, never a valid edge)
- * \param[in] triangle_edge_on #T 1 where seen edge-on (never a valid edge), or null
- * \param[in] vertex_labels #V labels, 0 = unlabeled
+ * \param[in] triangles \#T triangles over vertex ids
+ * \param[in] triangle_normals \#T unit normals (NaN: degenerate, never a valid edge)
+ * \param[in] triangle_edge_on \#T 1 where seen edge-on (never a valid edge), or null
+ * \param[in] vertex_labels \#V labels, 0 = unlabeled
  * \param[in] label_normals normal of label l at [l - 1]
  * \param[in] max_edge_triangle_angle [rad]
- * \param[out] labels #T labels (0 when no vertex is labeled)
- * \param[out] classes #T classes
+ * \param[out] labels \#T labels (0 when no vertex is labeled)
+ * \param[out] classes \#T classes
  * \param[in] num_threads threads (0: defaultThreads()); the result does not depend on
  * it
  */

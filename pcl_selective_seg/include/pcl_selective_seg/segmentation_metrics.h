@@ -47,13 +47,13 @@ struct OverlapEntry {
 
 /** \brief Sparse overlap (contingency) table of a predicted and a GT labelling. */
 struct LabelOverlap {
-  /** #G distinct nonzero GT labels, increasing. */
+  /** \#G distinct nonzero GT labels, increasing. */
   std::vector<std::uint32_t> gt_labels;
-  /** #G points of each GT region (P_n). */
+  /** \#G points of each GT region (P_n). */
   std::vector<std::size_t> gt_sizes;
-  /** #M distinct nonzero predicted labels found on GT-valid points, increasing. */
+  /** \#M distinct nonzero predicted labels found on GT-valid points, increasing. */
   std::vector<std::uint32_t> predicted_labels;
-  /** #M GT-valid points of each predicted region (P_m). */
+  /** \#M GT-valid points of each predicted region (P_m). */
   std::vector<std::size_t> predicted_sizes;
   /** Nonzero overlaps, sorted by (gt, predicted); their counts sum to
    * num_valid_points - num_unlabeled_points. */
@@ -65,8 +65,8 @@ struct LabelOverlap {
 };
 
 /** \brief Build the overlap table of two labellings.
- * \param[in] predicted #N predicted labels, 0 = unlabeled
- * \param[in] ground_truth #N GT labels, 0 = invalid (ignored)
+ * \param[in] predicted \#N predicted labels, 0 = unlabeled
+ * \param[in] ground_truth \#N GT labels, 0 = invalid (ignored)
  * \param[out] overlap the table; cleared on failure
  * \return false (with PCL_ERROR) when the two vectors differ in length
  */
@@ -103,8 +103,8 @@ PCL_EXPORTS bool buildLabelOverlap(const std::vector<std::uint32_t>& predicted,
  */
 struct HooverScores {
   double tolerance = 0.8;                ///< T, in [0.5, 1]
-  std::size_t num_gt_regions = 0;        ///< #G
-  std::size_t num_predicted_regions = 0; ///< #M (regions with a GT-valid point)
+  std::size_t num_gt_regions = 0;        ///< \#G
+  std::size_t num_predicted_regions = 0; ///< \#M (regions with a GT-valid point)
   std::size_t correct_detections = 0;    ///< pairs (m, n)
   std::size_t over_segmentations = 0;    ///< GT regions over-segmented
   std::size_t under_segmentations = 0;   ///< predicted regions under-segmenting
@@ -119,8 +119,8 @@ struct HooverScores {
 PCL_EXPORTS HooverScores hooverScores(const LabelOverlap& overlap, double tolerance);
 
 /** \brief Hoover counts of two labellings at one tolerance (see HooverScores).
- * \param[in] predicted #N predicted labels, 0 = unlabeled
- * \param[in] ground_truth #N GT labels, 0 = invalid (ignored)
+ * \param[in] predicted \#N predicted labels, 0 = unlabeled
+ * \param[in] ground_truth \#N GT labels, 0 = invalid (ignored)
  * \param[in] tolerance T, in [0.5, 1] (the paper's range; 0.8 in its tables)
  * \param[out] scores the counts; zero on failure
  * \return false (with PCL_ERROR) on a length mismatch or T out of range
@@ -136,8 +136,8 @@ PCL_EXPORTS bool hooverMetrics(const std::vector<std::uint32_t>& predicted,
  * max_tolerance by more than step / 1000 (so 0.5..0.95 by 0.05 gives 10 values, the
  * last 0.95). The overlap table is built once.
  *
- * \param[in] predicted #N predicted labels, 0 = unlabeled
- * \param[in] ground_truth #N GT labels, 0 = invalid (ignored)
+ * \param[in] predicted \#N predicted labels, 0 = unlabeled
+ * \param[in] ground_truth \#N GT labels, 0 = invalid (ignored)
  * \param[out] sweep one HooverScores per tolerance, increasing; empty on failure
  * \param[in] min_tolerance first T, in [0.5, 1]
  * \param[in] max_tolerance last T, in [min_tolerance, 1]
@@ -161,7 +161,7 @@ struct MajorityLabel {
   double purity = 0.0;   ///< count / P_m, in (0, 1]
 };
 
-/** \brief #M majority GT regions, one per LabelOverlap::predicted_labels entry. */
+/** \brief \#M majority GT regions, one per LabelOverlap::predicted_labels entry. */
 PCL_EXPORTS std::vector<MajorityLabel> majorityLabels(const LabelOverlap& overlap);
 
 /** \brief Under-segmentation error of object-level segmentation. */
@@ -182,7 +182,7 @@ PCL_EXPORTS UnderSegmentationError underSegmentationError(const LabelOverlap& ov
 /** \brief How many predicted regions, largest first, cover a fraction of the points. */
 struct SegmentCoverage {
   double fraction = 0.9;    ///< the target fraction of GT-valid points
-  std::size_t segments = 0; ///< regions needed; all #M when the target is not reached
+  std::size_t segments = 0; ///< regions needed; all \#M when the target is not reached
   bool reached = false;     ///< false when all regions together fall short
   double covered_fraction = 0; ///< fraction covered by those regions, NaN when no point
 };
@@ -198,9 +198,9 @@ PCL_EXPORTS SegmentCoverage segmentsCovering(const LabelOverlap& overlap,
 
 /** \brief Parts recoverable as a union of pure predicted regions. */
 struct PartRecovery {
-  std::size_t num_parts = 0;         ///< GT regions (#G)
+  std::size_t num_parts = 0;         ///< GT regions (\#G)
   std::size_t recoverable_parts = 0; ///< parts meeting the criterion
-  double fraction = 0.0;             ///< recoverable_parts / num_parts, NaN when #G = 0
+  double fraction = 0.0; ///< recoverable_parts / num_parts, NaN when \#G = 0
 };
 
 /** \brief Fraction of GT parts recoverable from pure predicted regions.
@@ -240,9 +240,9 @@ struct BoundaryRecall {
  * - A GT boundary point is matched when a predicted boundary point lies within
  *   \a match_distance of it (inclusive).
  *
- * \param[in] cloud #N points [m]
- * \param[in] predicted #N predicted labels, 0 = unlabeled
- * \param[in] ground_truth #N GT labels, 0 = invalid (ignored)
+ * \param[in] cloud \#N points [m]
+ * \param[in] predicted \#N predicted labels, 0 = unlabeled
+ * \param[in] ground_truth \#N GT labels, 0 = invalid (ignored)
  * \param[in] radius neighbourhood radius r of both boundaries [m], > 0
  * \param[in] match_distance largest GT-to-predicted boundary distance d [m], >= 0
  * \param[out] result counts and recall; zero on failure
@@ -267,8 +267,8 @@ struct ObjectMetricsParams {
 
 /** \brief All object-level metrics of one labelling. */
 struct ObjectScores {
-  std::size_t num_gt_regions = 0;        ///< #G
-  std::size_t num_predicted_regions = 0; ///< #M
+  std::size_t num_gt_regions = 0;        ///< \#G
+  std::size_t num_predicted_regions = 0; ///< \#M
   double unlabeled_fraction = 0.0; ///< GT-valid points predicted 0, NaN when none valid
   UnderSegmentationError under_segmentation;
   BoundaryRecall boundary;
@@ -277,9 +277,9 @@ struct ObjectScores {
 };
 
 /** \brief Object-level metrics, for ground truth with one label per whole object.
- * \param[in] cloud #N points [m]
- * \param[in] predicted #N predicted labels, 0 = unlabeled
- * \param[in] ground_truth #N GT labels, 0 = invalid (ignored)
+ * \param[in] cloud \#N points [m]
+ * \param[in] predicted \#N predicted labels, 0 = unlabeled
+ * \param[in] ground_truth \#N GT labels, 0 = invalid (ignored)
  * \param[in] params distances and fractions
  * \param[out] scores the metrics; zero on failure
  * \return false (with PCL_ERROR) on a size mismatch or a parameter out of range
@@ -300,9 +300,9 @@ PCL_EXPORTS bool objectMetrics(const pcl::PointCloud<pcl::PointXYZ>& cloud,
  * index): at a depth jump that is the point on the occluding contour, at a crease a
  * point on one of the two faces. The result lists each boundary point once.
  *
- * \param[in] cloud #N points [m]
+ * \param[in] cloud \#N points [m]
  * \param[in] triangles mesh triangles over point indices in [0, N)
- * \param[in] labels #N labels (predicted or ground truth)
+ * \param[in] labels \#N labels (predicted or ground truth)
  * \param[in] sensor_origin the sensor's position in the cloud's frame [m]
  * \param[in] max_edge_angle largest angle an edge subtends at the sensor [rad], > 0
  *            (infinity: every edge)

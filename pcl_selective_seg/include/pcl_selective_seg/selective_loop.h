@@ -62,10 +62,14 @@ struct PCL_EXPORTS ScanScore {
   double under_segmentation = 0.0; ///< metrics::underSegmentationError
 };
 
-/** \brief Score a segmentation of a labeled scan: \a labels and \a triangles (over
- * point indices) from SegmentationResult, ground truth from the cloud's labels.
+/** \brief Score a segmentation of a labeled scan: the labels and the triangles (over
+ * point indices) of \a result, ground truth from the cloud's labels.
+ * \param[in] cloud the scan, each point labeled with the surface it hit
+ * \param[in] result the segmentation of \a cloud
+ * \param[in] reference the scene's ground-truth boundary (makeReferenceBoundary())
  * \param[in] max_edge_angle predicted boundary edges subtending more are left out
- *            [rad] */
+ *            [rad]
+ * \param[out] score the figures; points, windows and times are left as they are */
 PCL_EXPORTS bool scoreSegmentation(const pcl::PointCloud<pcl::PointXYZL>& cloud,
                                    const SegmentationResult& result,
                                    const ReferenceBoundary& reference,
@@ -147,6 +151,11 @@ runSelectiveLoop(const SimulationSetup& setup,
 
 /** \brief A uniform scan of the whole view window at \a step, segmented and scored
  * (boundary edges up to 4 steps).
+ * \param[in] setup the scene and its sensor
+ * \param[in] step the scan's angular step [rad]
+ * \param[in] segmentation the segmentation's parameters
+ * \param[in] reference the scene's ground-truth boundary (makeReferenceBoundary())
+ * \param[out] score the figures of the scan and its segmentation
  * \param[out] cloud if non-null: the scan */
 PCL_EXPORTS bool runUniformScan(const SimulationSetup& setup,
                                 double step,

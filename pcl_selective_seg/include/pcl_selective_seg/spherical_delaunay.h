@@ -45,18 +45,18 @@ enum PointStatus : pcl::index_t {
  * Mesh vertices are the distinct quantized angle pairs, numbered in increasing
  * (theta, phi) order, so the numbering depends on the point set only. */
 struct SphericalTriangulation {
-  /** #N per input point: its vertex id, or a negative PointStatus. */
+  /** \#N per input point: its vertex id, or a negative PointStatus. */
   std::vector<pcl::index_t> point_vertex;
-  /** #V the input point that represents each vertex: among the points sharing its
+  /** \#V the input point that represents each vertex: among the points sharing its
    * angles, the nearest to the sensor (ties: smallest x, y, z). */
   pcl::Indices vertex_point;
-  /** #V quantized (theta, phi) of each vertex: angle / angle_quantization, rounded. */
+  /** \#V quantized (theta, phi) of each vertex: angle / angle_quantization, rounded. */
   std::vector<QuantizedPoint> vertex_angles;
-  /** #V position of each vertex's representative point in the sensor frame [m]. */
+  /** \#V position of each vertex's representative point in the sensor frame [m]. */
   std::vector<Eigen::Vector3f> vertex_positions;
-  /** #T triangles over vertex ids, counter-clockwise in (theta, phi). */
+  /** \#T triangles over vertex ids, counter-clockwise in (theta, phi). */
   std::vector<Triangle> triangles;
-  /** #T triangle across the edge opposite each vertex, -1 on the boundary (empty when
+  /** \#T triangle across the edge opposite each vertex, -1 on the boundary (empty when
    * SphericalDelaunay::setComputeNeighbours(false)). */
   std::vector<Triangle> neighbours;
   std::size_t num_outside_indices = 0;
