@@ -31,6 +31,7 @@ defaultThreads()
   return 1u;
 #endif
 }
+
 namespace {
 
 bool
