@@ -49,8 +49,9 @@ PCL_EXPORTS void computeTriangleNormals(const Vector3fVector& positions,
  * \param[out] vertex_normals \#V unit normals; NaN where no valid triangle is incident
  *             or the weighted normals cancel
  * \param[out] vertex_areas \#V areas A_p [m^2]
- * \param[in] num_threads OpenMP threads, 0 = defaultThreads() (the result does not
- * depend on it) \param[in] neighbours optional: the adjacency of \a triangles
+ * \param[in] num_threads OpenMP threads, 0 = defaultThreads() (the result does
+ *            not depend on it)
+ * \param[in] neighbours optional: the adjacency of \a triangles
  *            (computeTriangleNeighbours()). Each triangle's terms are added to its
  *            vertices in increasing triangle order: the same sums in the same order as
  *            gathering them per vertex, so the same bits. Large meshes are split among

@@ -85,8 +85,8 @@ PCL_EXPORTS void mergeSeedSegments(const MergeInput& input,
  * \param[in] max_edge_triangle_angle [rad]
  * \param[out] labels \#T labels (0 when no vertex is labeled)
  * \param[out] classes \#T classes
- * \param[in] num_threads threads (0: defaultThreads()); the result does not depend on
- * it
+ * \param[in] num_threads threads (0: defaultThreads()); the result does not
+ *            depend on it
  */
 PCL_EXPORTS void classifyTriangles(const std::vector<Triangle>& triangles,
                                    const Vector3fVector& triangle_normals,
@@ -113,16 +113,16 @@ struct PCL_EXPORTS Incidence {
 /** \brief The points of each label: clusters[l - 1].indices lists the i with labels[i]
  * == l, in increasing order, for l = 1 .. num_labels (label 0, and labels above
  * num_labels, are left out). Headers are left as they are.
- * \param[in] num_threads threads (0: defaultThreads()); the result does not depend on
- * it */
+ * \param[in] num_threads threads (0: defaultThreads()); the result does not
+ *            depend on it */
 PCL_EXPORTS void clustersFromLabels(const std::vector<std::uint32_t>& labels,
                                     std::size_t num_labels,
                                     std::vector<pcl::PointIndices>& clusters,
                                     int num_threads = 1);
 
 /** \brief Triangles at each vertex, in increasing triangle order.
- * \param[in] num_threads threads (0: defaultThreads()); the result does not depend on
- * it */
+ * \param[in] num_threads threads (0: defaultThreads()); the result does not
+ *            depend on it */
 PCL_EXPORTS Incidence vertexTriangles(const std::vector<Triangle>& triangles,
                                       std::size_t num_vertices,
                                       int num_threads = 1);
