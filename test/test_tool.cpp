@@ -38,6 +38,14 @@ run(const std::string& args)
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
+/** The bytes of a file ("" when it cannot be read). */
+std::string
+fileBytes(const std::string& path)
+{
+  std::ifstream in(path, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), {});
+}
+
 class Tool : public ::testing::Test {
 protected:
   void
@@ -114,8 +122,7 @@ TEST_F(Tool, WritesEveryOutputInInputOrder)
   EXPECT_EQ(labeled_points, 209280u);
 
   // The JSON summary and the meshes agree on the counts.
-  std::ifstream json(out("summary.json"));
-  const std::string text((std::istreambuf_iterator<char>(json)), {});
+  const std::string text = fileBytes(out("summary.json"));
   EXPECT_NE(text.find("\"labeled\": 209280"), std::string::npos);
   const auto at = text.find("\"triangles\": ");
   ASSERT_NE(at, std::string::npos);
@@ -181,10 +188,8 @@ TEST_F(Tool, ThreadCountKeepsTheOutput)
   const std::string in = "'" + scan + "' -ignore_viewpoint -o ";
   ASSERT_EQ(run(in + out("one.pcd") + " -threads 1"), 0);
   ASSERT_EQ(run(in + out("two.pcd") + " -threads 2"), 0);
-  std::ifstream one(out("one.pcd"), std::ios::binary),
-      two(out("two.pcd"), std::ios::binary);
-  const std::string a((std::istreambuf_iterator<char>(one)), {});
-  const std::string b((std::istreambuf_iterator<char>(two)), {});
+  const std::string a = fileBytes(out("one.pcd"));
+  const std::string b = fileBytes(out("two.pcd"));
   EXPECT_GT(a.size(), 1000u);
   EXPECT_EQ(a, b);
 }
