@@ -186,25 +186,13 @@ TEST(SelectiveSegmentation, AutomaticThreadsFollowOpenMP)
 #endif
 }
 
-TEST(SelectiveSegmentation, ThreadCountDoesNotChangeTheResult)
+namespace {
+
+/** Results of the same cloud on 1, 2 and 3 threads: equal in every array. */
+void
+expectSameResults(const std::vector<SegmentationResult>& results,
+                  const std::vector<std::vector<pcl::PointIndices>>& all_clusters)
 {
-  // Large enough for the chunked (per-thread) sorts and incidence lists.
-  const auto cloud = cubeScene(80000, 8);
-  std::vector<SegmentationResult> results;
-  std::vector<std::vector<pcl::PointIndices>> all_clusters;
-  for (const unsigned int threads : {1u, 2u, 3u}) {
-    SelectiveSegmentation<pcl::PointXYZL> seg;
-    seg.setNumberOfThreads(threads); // PCL's name for the num_threads parameter
-    ASSERT_EQ(seg.getParameters().num_threads, static_cast<int>(threads));
-    std::vector<pcl::PointIndices> clusters;
-    ASSERT_TRUE(segment<pcl::PointXYZL>(cloud, seg, clusters));
-    results.push_back(seg.getResult());
-    all_clusters.push_back(clusters);
-  }
-  ASSERT_GT(results[0].mesh.triangles.size(), 65536u);
-  // Enough leaves for the seed growth to run ahead on the threads (from 1,024), over
-  // several windows.
-  ASSERT_GT(results[0].leaves.size(), 4096u);
   // Each cluster: its points in increasing order, all with its label.
   for (std::size_t r = 0; r < all_clusters[0].size(); ++r) {
     const auto& indices = all_clusters[0][r].indices;
@@ -232,6 +220,38 @@ TEST(SelectiveSegmentation, ThreadCountDoesNotChangeTheResult)
       EXPECT_EQ(results[0].leaves[l].area, results[k].leaves[l].area);
       EXPECT_TRUE(results[0].leaves[l].normal == results[k].leaves[l].normal);
     }
+  }
+}
+
+} // namespace
+
+TEST(SelectiveSegmentation, ThreadCountDoesNotChangeTheResult)
+{
+  // 80,000 rays: enough for the chunked (per-thread) sorts and incidence lists and for
+  // the seed growth to run ahead on the threads over several windows. 12,000 rays: a
+  // cloud whose passes over points run on the threads (from detail::kMinParallelItems,
+  // 8,192) but under the sizes where other parts do.
+  for (const std::size_t rays : {12000u, 80000u}) {
+    SCOPED_TRACE(rays);
+    const auto cloud = cubeScene(rays, 8);
+    ASSERT_GE(cloud->size(), pcl::selective_seg::detail::kMinParallelItems);
+    std::vector<SegmentationResult> results;
+    std::vector<std::vector<pcl::PointIndices>> all_clusters;
+    for (const unsigned int threads : {1u, 2u, 3u}) {
+      SelectiveSegmentation<pcl::PointXYZL> seg;
+      seg.setNumberOfThreads(threads); // PCL's name for the num_threads parameter
+      ASSERT_EQ(seg.getParameters().num_threads, static_cast<int>(threads));
+      std::vector<pcl::PointIndices> clusters;
+      ASSERT_TRUE(segment<pcl::PointXYZL>(cloud, seg, clusters));
+      results.push_back(seg.getResult());
+      all_clusters.push_back(clusters);
+    }
+    if (rays == 80000u) {
+      ASSERT_GT(results[0].mesh.triangles.size(), 65536u);
+      // The seed growth runs ahead on the threads from 1,024 leaves, in windows.
+      ASSERT_GT(results[0].leaves.size(), 4096u);
+    }
+    expectSameResults(results, all_clusters);
   }
 }
 

@@ -34,9 +34,9 @@ constexpr std::int32_t kMaxDelaunayCoordinate = 1 << 26;
 namespace detail {
 /** \brief The fewest items (triangles, vertices, sampled edges, list items) a loop of
  * the pipeline splits among threads; below it one thread is as fast. Measured on door
- * scans of 5k-46k points (docs/performance_notes.md, round 5). No result depends on
- * it. */
-constexpr std::size_t kMinParallelItems = 16384;
+ * scans of 5k-46k points (docs/performance_notes.md, round 5 and session 17). No result
+ * depends on it. */
+constexpr std::size_t kMinParallelItems = 8192;
 } // namespace detail
 
 /** \brief A triangle as three vertex ids, counter-clockwise in the 2-D plane. */

@@ -58,8 +58,9 @@ PCL_EXPORTS void computeTriangleNormals(const Vector3fVector& positions,
  *            the threads when the adjacency is given and the triangles come in
  *            delaunay2d()'s canonical order (by smallest vertex); without them the
  *            sums of a large mesh are gathered through vertex -> triangle lists on all
- *            threads (the same bits again). On one thread or below 16,384 triangles the
- *            pass is sequential, for any triangle order.
+ *            threads (the same bits again). On one thread or below
+ *            detail::kMinParallelItems triangles the pass is sequential, for any
+ *            triangle order.
  */
 PCL_EXPORTS void computeVertexNormals(std::size_t num_vertices,
                                       const std::vector<Triangle>& triangles,
