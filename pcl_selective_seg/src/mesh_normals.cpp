@@ -24,12 +24,7 @@ namespace selective_seg {
 
 namespace {
 
-/** OpenMP thread count: 0 = defaultThreads(). */
-int
-threads(int requested)
-{
-  return requested > 0 ? requested : static_cast<int>(defaultThreads());
-}
+using detail::threadCount;
 
 /** The weight of a triangle in eq. 2, or 0 when it is degenerate. */
 double
@@ -181,7 +176,7 @@ computeTriangleNormals(const Vector3fVector& positions,
   areas.assign(triangles.size(), 0.0);
   const Eigen::Vector3d eye = viewpoint.cast<double>();
   const auto n_tri = static_cast<std::ptrdiff_t>(triangles.size());
-#pragma omp parallel for num_threads(threads(num_threads)) schedule(static)
+#pragma omp parallel for num_threads(threadCount(num_threads)) schedule(static)
   for (std::ptrdiff_t t = 0; t < n_tri; ++t)
     triangleNormal(positions, triangles[t], eye, normals[t], areas[t]);
 }
@@ -203,7 +198,7 @@ computeTriangleNormalsAndEdgeOn(const Vector3fVector& positions,
   const double min_cos = minIncidenceCos(max_incidence);
   const Eigen::Vector3d eye = viewpoint.cast<double>();
   const auto n_tri = static_cast<std::ptrdiff_t>(triangles.size());
-#pragma omp parallel for num_threads(threads(num_threads)) schedule(dynamic, 1024)
+#pragma omp parallel for num_threads(threadCount(num_threads)) schedule(dynamic, 1024)
   for (std::ptrdiff_t t = 0; t < n_tri; ++t)
     triangleNormalAndEdgeOn(
         positions, triangles[t], eye, min_cos, normals[t], areas[t], edge_on[t]);
@@ -226,8 +221,8 @@ updateTriangleNormalsAndEdgeOn(const Vector3fVector& positions,
   std::vector<double> new_areas(n_new);
   std::vector<std::uint8_t> new_edge_on(n_new);
   const auto n_old = static_cast<std::ptrdiff_t>(old_to_new.size());
-#pragma omp parallel for num_threads(threads(num_threads)) schedule(static) \
-    if (old_to_new.size() >= detail::kMinParallelItems)
+#pragma omp parallel for num_threads(threadCount(num_threads))                         \
+    schedule(static) if (old_to_new.size() >= detail::kMinParallelItems)
   for (std::ptrdiff_t k = 0; k < n_old; ++k) {
     const pcl::index_t t = old_to_new[k];
     if (t < 0)
@@ -239,8 +234,8 @@ updateTriangleNormalsAndEdgeOn(const Vector3fVector& positions,
   const double min_cos = minIncidenceCos(max_incidence);
   const Eigen::Vector3d eye = viewpoint.cast<double>();
   const auto n_changed = static_cast<std::ptrdiff_t>(changed.size());
-#pragma omp parallel for num_threads(threads(num_threads)) schedule(dynamic, 1024) \
-    if (changed.size() >= detail::kMinParallelItems)
+#pragma omp parallel for num_threads(threadCount(num_threads))                         \
+    schedule(dynamic, 1024) if (changed.size() >= detail::kMinParallelItems)
   for (std::ptrdiff_t k = 0; k < n_changed; ++k) {
     const pcl::index_t t = changed[k];
     triangleNormalAndEdgeOn(positions,
@@ -420,15 +415,15 @@ computeVertexNormals(std::size_t num_vertices,
                            areas,
                            vertex_normals,
                            vertex_areas,
-                           threads(num_threads)))
+                           threadCount(num_threads)))
     return;
   // Gathered per vertex over its triangles in increasing order: the same sums, in the
   // same order, whatever the number of threads.
   const Incidence incident =
-      vertexTriangles(triangles, num_vertices, threads(num_threads));
+      vertexTriangles(triangles, num_vertices, threadCount(num_threads));
   vertex_areas.assign(num_vertices, 0.0);
   vertex_normals.resize(num_vertices);
-#pragma omp parallel for num_threads(threads(num_threads)) schedule(static)
+#pragma omp parallel for num_threads(threadCount(num_threads)) schedule(static)
   for (std::ptrdiff_t v = 0; v < static_cast<std::ptrdiff_t>(num_vertices); ++v)
     vertexNormal(incident.items.data() + incident.offsets[v],
                  incident.items.data() + incident.offsets[v + 1],
@@ -625,7 +620,7 @@ markEdgeOnTriangles(const Vector3fVector& positions,
   const double min_cos = minIncidenceCos(max_incidence);
   const Eigen::Vector3d eye = viewpoint.cast<double>();
   const auto n_tri = static_cast<std::ptrdiff_t>(triangles.size());
-#pragma omp parallel for num_threads(threads(num_threads)) schedule(static)
+#pragma omp parallel for num_threads(threadCount(num_threads)) schedule(static)
   for (std::ptrdiff_t t = 0; t < n_tri; ++t)
     edge_on[t] = isEdgeOn(positions, triangles[t], normals[t], eye, min_cos);
 }
@@ -653,7 +648,7 @@ updateVertexNormals(const std::vector<Triangle>& triangles,
                      areas,
                      vertex_normals,
                      vertex_areas,
-                     threads(num_threads));
+                     threadCount(num_threads));
 }
 
 double
@@ -684,9 +679,11 @@ medianEdgeLength(const Vector3fVector& positions,
   };
   std::uint64_t lowest = std::numeric_limits<std::uint64_t>::max(), highest = 0;
 #ifdef _OPENMP
-#pragma omp parallel for num_threads(threads(num_threads)) schedule(static) \
-    if (static_cast<std::size_t>(sampled) >= detail::kMinParallelItems)          \
-    reduction(min : lowest) reduction(max : highest)
+#pragma omp parallel for num_threads(threadCount(num_threads)) schedule(               \
+    static) if (static_cast <std::size_t>(sampled) >= detail::kMinParallelItems)       \
+    reduction(min                                                                      \
+              : lowest) reduction(max                                                  \
+                                  : highest)
 #endif
   for (std::ptrdiff_t j = 0; j < sampled; ++j) {
     const Triangle& t = triangles[static_cast<std::size_t>(j) * stride];
@@ -707,7 +704,7 @@ medianEdgeLength(const Vector3fVector& positions,
   const auto bucketOf = [&](double v) { return (bits(v) - lowest) >> shift; };
   const std::size_t rank = num_squares / 2;
   const bool parallel = static_cast<std::size_t>(sampled) >= detail::kMinParallelItems;
-  const int num_parts = parallel ? threads(num_threads) : 1;
+  const int num_parts = parallel ? threadCount(num_threads) : 1;
   std::vector<std::uint32_t> histograms(kBuckets * static_cast<std::size_t>(num_parts),
                                         0);
 #ifdef _OPENMP

@@ -41,7 +41,7 @@ clustersFromLabels(const std::vector<std::uint32_t>& labels,
         if (labels[i] > 0 && labels[i] <= num_labels)
           f(static_cast<pcl::index_t>(labels[i] - 1), static_cast<pcl::index_t>(i));
       },
-      num_threads > 0 ? num_threads : static_cast<int>(defaultThreads()),
+      detail::threadCount(num_threads),
       offsets,
       [&](const std::vector<std::size_t>& bounds) {
         for (std::size_t l = 0; l < num_labels; ++l)
@@ -64,7 +64,7 @@ vertexTriangles(const std::vector<Triangle>& triangles,
         for (const auto v : triangles[t])
           f(v);
       },
-      num_threads > 0 ? num_threads : static_cast<int>(defaultThreads()));
+      detail::threadCount(num_threads));
 }
 
 namespace {
@@ -167,7 +167,7 @@ struct LeafTriangles {
             forEachDistinct(leaves, [&](pcl::index_t l) { f(l, entry); });
           }
         },
-        in.num_threads > 0 ? in.num_threads : static_cast<int>(defaultThreads()),
+        detail::threadCount(in.num_threads),
         offsets,
         entries);
   }
@@ -362,8 +362,7 @@ public:
     leaf_segment.assign(num_leaves, -1);
     segment_normals.clear();
     const std::vector<pcl::index_t> order = seedOrder(*in_.vertex_leaf, num_leaves);
-    const int threads =
-        in_.num_threads > 0 ? in_.num_threads : static_cast<int>(defaultThreads());
+    const int threads = detail::threadCount(in_.num_threads);
     const std::size_t parts =
         std::min<std::size_t>(kMaxParts, static_cast<std::size_t>(threads));
     SegmentGrowth growth(in_, adjacency_);
@@ -523,7 +522,7 @@ classifyTriangles(const std::vector<Triangle>& triangles,
   const double cos_edge = std::cos(max_edge_triangle_angle);
   labels.assign(triangles.size(), 0);
   classes.assign(triangles.size(), TriangleClass::InvalidEdge);
-  const int threads = num_threads > 0 ? num_threads : static_cast<int>(defaultThreads());
+  const int threads = detail::threadCount(num_threads);
   const auto num_triangles = static_cast<std::ptrdiff_t>(triangles.size());
   // Each triangle's label and class are its own: the same for any thread count.
 #ifdef _OPENMP

@@ -22,6 +22,16 @@ namespace selective_seg {
  * caller's that cannot nest, or when the library was built without OpenMP. */
 PCL_EXPORTS unsigned int defaultThreads();
 
+namespace detail {
+/** \brief The threads of a parallel stage asked for \a requested: itself when
+ * positive, else (0, automatic) defaultThreads(). */
+inline int
+threadCount(int requested)
+{
+  return requested > 0 ? requested : static_cast<int>(defaultThreads());
+}
+} // namespace detail
+
 /** \brief Which normal of a triangle eq. 8 compares with the segment normal. */
 enum class EdgeTriangleNormal : std::uint8_t {
   /** The facet normal, as in the paper. */

@@ -277,11 +277,7 @@ protected:
 
   /** \brief Threads of the parallel loops (parameter num_threads, 0 =
    * defaultThreads()). */
-  int numThreads() const
-  {
-    return params_.num_threads > 0 ? params_.num_threads
-                                   : static_cast<int>(defaultThreads());
-  }
+  int numThreads() const { return detail::threadCount(params_.num_threads); }
 
   /** \brief Rotation from the sensor frame to the cloud frame. */
   Eigen::Matrix3f sensorToCloud() const { return delaunay_.getSensorPose().rotation(); }
