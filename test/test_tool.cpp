@@ -20,7 +20,12 @@
 #include <sstream>
 #include <string>
 
+#include "process_memory.h"
 #include <sys/wait.h>
+
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 namespace fs = std::filesystem;
 
@@ -29,11 +34,13 @@ namespace {
 std::string tool;  // NOLINT: set once in main()
 std::string scan;  // NOLINT: set once in main()
 
-/** Run the tool with arguments; its exit code. */
+/** Run the tool with arguments, after an optional environment assignment
+ * ("NAME=value"); its exit code. */
 int
-run(const std::string& args)
+run(const std::string& args, const std::string& env = "")
 {
-  const std::string command = "'" + tool + "' " + args + " > /dev/null 2>&1";
+  const std::string command = (env.empty() ? "" : "env " + env + " ") + "'" + tool +
+                              "' " + args + " > /dev/null 2>&1";
   const int status = std::system(command.c_str());
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
@@ -194,6 +201,20 @@ TEST_F(Tool, ThreadCountKeepsTheOutput)
   EXPECT_EQ(a, b);
 }
 
+TEST_F(Tool, KeepingFreedMemoryKeepsTheOutput)
+{
+  // The tool keeps the memory it frees (keepFreedMemory()) unless the environment sets
+  // glibc's malloc options, as MALLOC_ARENA_MAX does here: same bytes either way.
+  const std::string in = "'" + scan + "' -ignore_viewpoint -o ";
+  ASSERT_EQ(run(in + out("kept.pcd") + " -mesh_ply " + out("kept.ply")), 0);
+  ASSERT_EQ(run(in + out("default.pcd") + " -mesh_ply " + out("default.ply"),
+                "MALLOC_ARENA_MAX=8"),
+            0);
+  EXPECT_GT(fileBytes(out("kept.pcd")).size(), 1000u);
+  EXPECT_EQ(fileBytes(out("kept.pcd")), fileBytes(out("default.pcd")));
+  EXPECT_EQ(fileBytes(out("kept.ply")), fileBytes(out("default.ply")));
+}
+
 TEST_F(Tool, UnwritableOutputLeavesNothingBehind)
 {
   EXPECT_EQ(run("'" + scan + "' -ignore_viewpoint -o " + out("labels.pcd") + " -json " +
@@ -219,6 +240,71 @@ TEST_F(Tool, ReadsTextInCentimetres)
   EXPECT_FLOAT_EQ(labeled[0].z, 2.0f);
   for (const auto& p : labeled)
     EXPECT_EQ(p.label, 1u);
+}
+
+/** Sets or clears an environment variable for the life of a scope. */
+class ScopedEnv {
+public:
+  ScopedEnv(const char* name, const char* value)
+      : name_(name)
+  {
+    if (const char* old = std::getenv(name)) {
+      had_ = true;
+      old_ = old;
+    }
+    if (value)
+      setenv(name, value, 1);
+    else
+      unsetenv(name);
+  }
+  ~ScopedEnv()
+  {
+    if (had_)
+      setenv(name_, old_.c_str(), 1);
+    else
+      unsetenv(name_);
+  }
+  ScopedEnv(const ScopedEnv&) = delete;
+  ScopedEnv& operator=(const ScopedEnv&) = delete;
+
+private:
+  const char* name_;
+  bool had_ = false;
+  std::string old_;
+};
+
+TEST(KeepFreedMemory, YieldsToTheUsersMallocSettingsAndThenMapsNothing)
+{
+  // The user's settings win: nothing is changed while any is present.
+  {
+    ScopedEnv arenas("MALLOC_ARENA_MAX", "8");
+    EXPECT_FALSE(selseg_apps::keepFreedMemory());
+  }
+  {
+    ScopedEnv tunables("GLIBC_TUNABLES", "glibc.malloc.hugetlb=1");
+    EXPECT_FALSE(selseg_apps::keepFreedMemory());
+  }
+#if defined(__GLIBC__)
+  ScopedEnv tunables("GLIBC_TUNABLES", nullptr);
+  for (const char* name : {"MALLOC_MMAP_MAX_",
+                           "MALLOC_MMAP_THRESHOLD_",
+                           "MALLOC_TRIM_THRESHOLD_",
+                           "MALLOC_TOP_PAD_",
+                           "MALLOC_ARENA_MAX"})
+    ASSERT_EQ(std::getenv(name), nullptr) << name << " is set: cannot test the default";
+  if (!selseg_apps::keepFreedMemory())
+    GTEST_SKIP() << "the allocator ignores mallopt() (a sanitizer's allocator)";
+  // Without the setting glibc maps a 64 MB block on its own; now it comes from the
+  // heap.
+  const std::size_t mapped_before = mallinfo2().hblks;
+  void* block = std::malloc(std::size_t{64} << 20);
+  ASSERT_NE(block, nullptr);
+  static_cast<volatile char*>(block)[0] = 1;
+  EXPECT_EQ(mallinfo2().hblks, mapped_before);
+  std::free(block);
+#else
+  EXPECT_FALSE(selseg_apps::keepFreedMemory());
+#endif
 }
 
 int

@@ -1,0 +1,30 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
+ */
+
+#pragma once
+
+namespace selseg_apps {
+
+/** \brief Let this process reuse the memory it frees instead of returning it to the
+ * system and asking for it again (glibc's allocator: no allocation mapped on its own,
+ * no trimming of the heap).
+ *
+ * The pipeline frees large arrays between its stages and allocates others of similar
+ * sizes; by default glibc maps each array above its threshold afresh (32 MB at most)
+ * and the process pays a page fault for every 4 KB of it again. The command-line tool
+ * runs one pipeline and exits, so keeping the freed memory costs nothing: measured on
+ * the 1M and 3M-point door scans, the same peak resident memory (within 0.3%) and a
+ * 7-12% faster pipeline (docs/performance.md, "Memory").
+ *
+ * The library itself never does this: it does not own its users' processes.
+ * \return false (nothing changed) with another C library, with an allocator that
+ *         ignores mallopt() (a sanitizer's), or when the environment already sets
+ *         glibc's malloc options (GLIBC_TUNABLES with glibc.malloc.*, MALLOC_ARENA_MAX,
+ *         MALLOC_MMAP_MAX_, MALLOC_MMAP_THRESHOLD_, MALLOC_TRIM_THRESHOLD_ or
+ *         MALLOC_TOP_PAD_): the user's choice wins. */
+bool keepFreedMemory();
+
+} // namespace selseg_apps
