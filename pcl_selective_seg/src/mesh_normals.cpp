@@ -678,12 +678,14 @@ medianEdgeLength(const Vector3fVector& positions,
     return b;
   };
   std::uint64_t lowest = std::numeric_limits<std::uint64_t>::max(), highest = 0;
+  const bool parallel = static_cast<std::size_t>(sampled) >= detail::kMinParallelItems;
+  const int num_parts = parallel ? threadCount(num_threads) : 1;
 #ifdef _OPENMP
-#pragma omp parallel for num_threads(threadCount(num_threads)) schedule(               \
-    static) if (static_cast <std::size_t>(sampled) >= detail::kMinParallelItems)       \
-    reduction(min                                                                      \
-              : lowest) reduction(max                                                  \
-                                  : highest)
+  // clang-format would break the reduction clauses apart.
+  // clang-format off
+#pragma omp parallel for num_threads(num_parts) schedule(static) if (parallel) \
+    reduction(min : lowest) reduction(max : highest)
+  // clang-format on
 #endif
   for (std::ptrdiff_t j = 0; j < sampled; ++j) {
     const Triangle& t = triangles[static_cast<std::size_t>(j) * stride];
@@ -703,8 +705,6 @@ medianEdgeLength(const Vector3fVector& positions,
     ++shift;
   const auto bucketOf = [&](double v) { return (bits(v) - lowest) >> shift; };
   const std::size_t rank = num_squares / 2;
-  const bool parallel = static_cast<std::size_t>(sampled) >= detail::kMinParallelItems;
-  const int num_parts = parallel ? threadCount(num_threads) : 1;
   std::vector<std::uint32_t> histograms(kBuckets * static_cast<std::size_t>(num_parts),
                                         0);
 #ifdef _OPENMP
