@@ -103,9 +103,10 @@ printHelp(const char* program)
   print_info(
       "Memory: the tool keeps the memory it frees for its later allocations\n"
       "(glibc; the same peak, fewer page faults), unless the environment sets\n"
-      "glibc's malloc options: GLIBC_TUNABLES with glibc.malloc.*, MALLOC_ARENA_MAX,\n"
-      "MALLOC_MMAP_MAX_, MALLOC_MMAP_THRESHOLD_, MALLOC_TRIM_THRESHOLD_ or\n"
-      "MALLOC_TOP_PAD_.\n");
+      "glibc's malloc options: GLIBC_TUNABLES with glibc.malloc.*, or one of\n ");
+  for (const char* name : selseg_apps::kMallocOptionVariables)
+    print_info(" %s", name);
+  print_info(".\n");
 }
 
 /** 1: a flag with a value, 0: a switch, -1: unknown. */

@@ -20,12 +20,13 @@
 #include <sstream>
 #include <string>
 
-#include "process_memory.h"
 #include <sys/wait.h>
 
 #if defined(__GLIBC__)
 #include <malloc.h>
 #endif
+
+#include "process_memory.h"
 
 namespace fs = std::filesystem;
 
@@ -286,11 +287,7 @@ TEST(KeepFreedMemory, YieldsToTheUsersMallocSettingsAndThenMapsNothing)
   }
 #if defined(__GLIBC__)
   ScopedEnv tunables("GLIBC_TUNABLES", nullptr);
-  for (const char* name : {"MALLOC_MMAP_MAX_",
-                           "MALLOC_MMAP_THRESHOLD_",
-                           "MALLOC_TRIM_THRESHOLD_",
-                           "MALLOC_TOP_PAD_",
-                           "MALLOC_ARENA_MAX"})
+  for (const char* name : selseg_apps::kMallocOptionVariables)
     ASSERT_EQ(std::getenv(name), nullptr) << name << " is set: cannot test the default";
   if (!selseg_apps::keepFreedMemory())
     GTEST_SKIP() << "the allocator ignores mallopt() (a sanitizer's allocator)";

@@ -9,7 +9,6 @@
 #include <climits>
 #include <cstdlib>
 #include <cstring>
-#include <initializer_list>
 
 #if defined(__GLIBC__)
 #include <malloc.h>
@@ -24,11 +23,7 @@ keepFreedMemory()
   const char* tunables = std::getenv("GLIBC_TUNABLES");
   if (tunables && std::strstr(tunables, "glibc.malloc."))
     return false;
-  for (const char* name : {"MALLOC_MMAP_MAX_",
-                           "MALLOC_MMAP_THRESHOLD_",
-                           "MALLOC_TRIM_THRESHOLD_",
-                           "MALLOC_TOP_PAD_",
-                           "MALLOC_ARENA_MAX"})
+  for (const char* name : kMallocOptionVariables)
     if (std::getenv(name))
       return false;
   // Every allocation from the heap, and the heap never given back: a freed array is

@@ -6,7 +6,19 @@
 
 #pragma once
 
+#include <array>
+
 namespace selseg_apps {
+
+/** \brief The environment variables (besides GLIBC_TUNABLES with glibc.malloc.*) by
+ * which a user sets glibc's malloc options; keepFreedMemory() leaves the allocator
+ * alone when any is set. */
+inline constexpr std::array<const char*, 5> kMallocOptionVariables = {
+    "MALLOC_ARENA_MAX",
+    "MALLOC_MMAP_MAX_",
+    "MALLOC_MMAP_THRESHOLD_",
+    "MALLOC_TRIM_THRESHOLD_",
+    "MALLOC_TOP_PAD_"};
 
 /** \brief Let this process reuse the memory it frees instead of returning it to the
  * system and asking for it again (glibc's allocator: no allocation mapped on its own,
@@ -22,9 +34,8 @@ namespace selseg_apps {
  * The library itself never does this: it does not own its users' processes.
  * \return false (nothing changed) with another C library, with an allocator that
  *         ignores mallopt() (a sanitizer's), or when the environment already sets
- *         glibc's malloc options (GLIBC_TUNABLES with glibc.malloc.*, MALLOC_ARENA_MAX,
- *         MALLOC_MMAP_MAX_, MALLOC_MMAP_THRESHOLD_, MALLOC_TRIM_THRESHOLD_ or
- *         MALLOC_TOP_PAD_): the user's choice wins. */
+ *         glibc's malloc options (GLIBC_TUNABLES with glibc.malloc.*, or one of
+ *         kMallocOptionVariables): the user's choice wins. */
 bool keepFreedMemory();
 
 } // namespace selseg_apps
