@@ -349,15 +349,23 @@ writeOutputs(const Options& opt,
                stats.already_fine,
                stats.over_budget);
   }
+  // The mesh writers use the segmentation's threads (-threads, 0 = automatic).
+  const int threads = opt.params.num_threads > 0
+                          ? opt.params.num_threads
+                          : static_cast<int>(pcl::selective_seg::defaultThreads());
   const bool ok =
       write(opt.labels,
             [&](const std::string& f) {
               return writeLabeledCloud(f, *seg.getLabeledCloud());
             }) &&
       write(opt.mesh_ply,
-            [&](const std::string& f) { return writeMeshPly(f, cloud, r.mesh); }) &&
+            [&](const std::string& f) {
+              return writeMeshPly(f, cloud, r.mesh, threads);
+            }) &&
       write(opt.mesh_vtk,
-            [&](const std::string& f) { return writeMeshVtk(f, cloud, r.mesh); }) &&
+            [&](const std::string& f) {
+              return writeMeshVtk(f, cloud, r.mesh, threads);
+            }) &&
       write(opt.leaves,
             [&](const std::string& f) { return writeLeaves(f, r.leaves); }) &&
       write(opt.json,

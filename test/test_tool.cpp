@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 #include <pcl/PCLPointCloud2.h>
 #include <pcl/common/io.h>
+#include <pcl/conversions.h>
 #include <pcl/io/pcd_io.h>
 #include <pcl/io/ply_io.h>
 
@@ -17,16 +18,20 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <sstream>
 #include <string>
 
 #include <sys/wait.h>
+#include <unistd.h>
 
 #if defined(__GLIBC__)
 #include <malloc.h>
 #endif
 
+#include "outputs.h"
 #include "process_memory.h"
+#include "segment_colors.h"
 
 namespace fs = std::filesystem;
 
@@ -302,6 +307,174 @@ TEST(KeepFreedMemory, YieldsToTheUsersMallocSettingsAndThenMapsNothing)
 #else
   EXPECT_FALSE(selseg_apps::keepFreedMemory());
 #endif
+}
+
+namespace {
+
+using pcl::selective_seg::SegmentedMesh;
+using pcl::selective_seg::TriangleClass;
+
+/** Bytes of a 32-bit pattern, least significant first or last. */
+std::string
+bytes32(std::uint32_t bits, bool big_endian)
+{
+  std::string out(4, '\0');
+  for (int i = 0; i < 4; ++i)
+    out[big_endian ? 3 - i : i] = static_cast<char>((bits >> (8 * i)) & 0xffu);
+  return out;
+}
+
+std::string
+bytes8(std::uint8_t value)
+{
+  return std::string(1, static_cast<char>(value));
+}
+
+/** Points 0-4; the triangles use 3, 1, 4, 2 (in that order of first use), not 0. */
+struct HandMadeMesh {
+  pcl::PointCloud<pcl::PointXYZ> cloud;
+  SegmentedMesh mesh;
+  // The coordinates' bit patterns (1 = 0x3f800000, 2 = 0x40000000, -1 = 0xbf800000,
+  // 0.5 = 0x3f000000), by point.
+  std::array<std::array<std::uint32_t, 3>, 5> bits{};
+  HandMadeMesh()
+  {
+    const std::array<std::array<float, 3>, 5> xyz = {
+        {{9, 9, 9}, {1, 0, 2}, {0.5f, 1, 2}, {-1, 0.5f, 2}, {0, 0, 1}}};
+    const std::array<std::array<std::uint32_t, 3>, 5> patterns = {
+        {{0x41100000, 0x41100000, 0x41100000},
+         {0x3f800000, 0, 0x40000000},
+         {0x3f000000, 0x3f800000, 0x40000000},
+         {0xbf800000, 0x3f000000, 0x40000000},
+         {0, 0, 0x3f800000}}};
+    bits = patterns;
+    for (const auto& p : xyz)
+      cloud.push_back(pcl::PointXYZ(p[0], p[1], p[2]));
+    mesh.triangles = {{3, 1, 4}, {1, 2, 4}};
+    mesh.labels = {2, 1};
+    mesh.classes = {TriangleClass::Interior, TriangleClass::ValidEdge};
+  }
+};
+
+} // namespace
+
+// The mesh files byte by byte: vertices numbered by first use, every number in the
+// format's byte order, each face's colour (its segment's, or white on an edge), label
+// and class.
+TEST(MeshWriters, KnownBytesForAHandMadeMesh)
+{
+  const HandMadeMesh m;
+  const auto dir =
+      fs::temp_directory_path() / ("selseg_writers_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const std::string ply = (dir / "mesh.ply").string(),
+                    vtk = (dir / "mesh.vtk").string();
+  ASSERT_TRUE(selseg_apps::writeMeshPly(ply, m.cloud, m.mesh));
+  ASSERT_TRUE(selseg_apps::writeMeshVtk(vtk, m.cloud, m.mesh));
+  const std::array<int, 4> order = {3, 1, 4, 2}; // output vertex -> input point
+  const std::array<std::array<std::uint32_t, 3>, 2> faces = {{{0, 1, 2}, {1, 3, 2}}};
+  const selseg_apps::Rgb interior = selseg_apps::segmentColor(2);
+  const std::array<selseg_apps::Rgb, 2> colors = {interior, {255, 255, 255}};
+  ASSERT_NE(interior, (selseg_apps::Rgb{255, 255, 255}));
+
+  std::string expected =
+      "ply\nformat binary_little_endian 1.0\n"
+      "comment pcl_selective_seg segmented mesh: edge triangles white\n"
+      "element vertex 4\n"
+      "property float x\nproperty float y\nproperty float z\n"
+      "element face 2\n"
+      "property list uchar int vertex_indices\n"
+      "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+      "property uint label\nproperty uchar class\nend_header\n";
+  for (const int p : order)
+    for (const auto b : m.bits[p])
+      expected += bytes32(b, false);
+  for (int t = 0; t < 2; ++t) {
+    expected += bytes8(3);
+    for (const auto v : faces[t])
+      expected += bytes32(v, false);
+    for (const auto c : colors[t])
+      expected += bytes8(c);
+    expected += bytes32(m.mesh.labels[t], false);
+    expected += bytes8(static_cast<std::uint8_t>(m.mesh.classes[t]));
+  }
+  EXPECT_TRUE(fileBytes(ply) == expected);
+
+  expected = "# vtk DataFile Version 3.0\npcl_selective_seg segmented mesh\nBINARY\n"
+             "DATASET POLYDATA\nPOINTS 4 float\n";
+  for (const int p : order)
+    for (const auto b : m.bits[p])
+      expected += bytes32(b, true);
+  expected += "\nPOLYGONS 2 8\n";
+  for (const auto& f : faces) {
+    expected += bytes32(3, true);
+    for (const auto v : f)
+      expected += bytes32(v, true);
+  }
+  expected += "\nCELL_DATA 2\nCOLOR_SCALARS colors 3\n";
+  for (const auto& c : colors)
+    for (const auto byte : c)
+      expected += bytes8(byte);
+  expected += "\nSCALARS label unsigned_int 1\nLOOKUP_TABLE default\n";
+  expected += bytes32(2, true) + bytes32(1, true);
+  expected += "\nSCALARS class unsigned_char 1\nLOOKUP_TABLE default\n";
+  expected += bytes8(0) + bytes8(1) + "\n";
+  EXPECT_TRUE(fileBytes(vtk) == expected);
+  fs::remove_all(dir);
+}
+
+// A mesh of several blocks of faces: the same bytes on one thread and on three, and
+// PCL reads back every face.
+TEST(MeshWriters, LargeMeshSameBytesForAnyThreadCount)
+{
+  // A grid of 400 x 400 points, two triangles per cell (318,402 faces: two blocks).
+  const int side = 400;
+  pcl::PointCloud<pcl::PointXYZ> cloud;
+  for (int r = 0; r < side; ++r)
+    for (int c = 0; c < side; ++c)
+      cloud.push_back(pcl::PointXYZ(0.01f * c, 0.01f * r, 1.0f));
+  SegmentedMesh mesh;
+  for (int r = 0; r + 1 < side; ++r)
+    for (int c = 0; c + 1 < side; ++c) {
+      const int a = r * side + c;
+      mesh.triangles.push_back({a, a + 1, a + side});
+      mesh.triangles.push_back({a + 1, a + side + 1, a + side});
+    }
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    mesh.labels.push_back(static_cast<std::uint32_t>(t % 97));
+    mesh.classes.push_back(static_cast<TriangleClass>(t % 3));
+  }
+  const auto dir = fs::temp_directory_path() /
+                   ("selseg_writers_large_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  std::map<std::string, std::string> one;
+  for (const int threads : {1, 3}) {
+    const std::string ply = (dir / "mesh.ply").string(),
+                      vtk = (dir / "mesh.vtk").string();
+    ASSERT_TRUE(selseg_apps::writeMeshPly(ply, cloud, mesh, threads));
+    ASSERT_TRUE(selseg_apps::writeMeshVtk(vtk, cloud, mesh, threads));
+    for (const auto& path : {ply, vtk}) {
+      const std::string content = fileBytes(path);
+      if (threads == 1)
+        one[path] = content;
+      else
+        EXPECT_TRUE(content == one[path]) << path << " differs with 3 threads";
+    }
+  }
+  pcl::PolygonMesh read;
+  ASSERT_EQ(pcl::io::loadPLYFile((dir / "mesh.ply").string(), read), 0);
+  ASSERT_EQ(read.polygons.size(), mesh.triangles.size());
+  ASSERT_EQ(read.cloud.width * read.cloud.height, cloud.size());
+  pcl::PointCloud<pcl::PointXYZ> vertices;
+  pcl::fromPCLPointCloud2(read.cloud, vertices);
+  for (std::size_t t = 0; t < mesh.triangles.size(); t += 997)
+    for (int i = 0; i < 3; ++i) {
+      const auto v = read.polygons[t].vertices[i];
+      ASSERT_EQ(vertices[v].getVector3fMap(),
+                cloud[mesh.triangles[t][i]].getVector3fMap())
+          << "face " << t << " corner " << i;
+    }
+  fs::remove_all(dir);
 }
 
 int

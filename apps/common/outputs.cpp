@@ -18,7 +18,9 @@
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
+#include <limits>
 #include <sstream>
+#include <type_traits>
 
 #include "segment_colors.h"
 
@@ -53,45 +55,122 @@ namespace {
 
 using pcl::selective_seg::SegmentedMesh;
 
-/** Vertices used by the triangles, renumbered densely in first-use order. */
+/** The vertices the triangles use, numbered densely in the order of their first use. */
 struct CompactMesh {
-  std::vector<pcl::index_t> points; ///< input index of each output vertex
-  std::vector<std::array<std::uint32_t, 3>> faces;
+  std::vector<pcl::index_t> points;  ///< input index of each output vertex
+  std::vector<std::uint32_t> number; ///< output number of each input point used
+
+  /** Output numbers of the corners of triangle \a t. */
+  std::array<std::uint32_t, 3> face(const SegmentedMesh& mesh, std::size_t t) const
+  {
+    const auto& c = mesh.triangles[t];
+    return {number[c[0]], number[c[1]], number[c[2]]};
+  }
 };
 
 CompactMesh
 compact(const SegmentedMesh& mesh, std::size_t num_points)
 {
+  constexpr auto kUnused = std::numeric_limits<std::uint32_t>::max();
   CompactMesh out;
-  std::vector<std::int64_t> renumber(num_points, -1);
-  out.faces.resize(mesh.triangles.size());
-  for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
-    for (int i = 0; i < 3; ++i) {
-      auto& slot = renumber[mesh.triangles[t][i]];
-      if (slot < 0) {
-        slot = static_cast<std::int64_t>(out.points.size());
-        out.points.push_back(mesh.triangles[t][i]);
+  out.number.assign(num_points, kUnused);
+  out.points.reserve(num_points);
+  for (const auto& triangle : mesh.triangles)
+    for (const pcl::index_t p : triangle) {
+      std::uint32_t& n = out.number[static_cast<std::size_t>(p)];
+      if (n == kUnused) {
+        n = static_cast<std::uint32_t>(out.points.size());
+        out.points.push_back(p);
       }
-      out.faces[t][i] = static_cast<std::uint32_t>(slot);
     }
   return out;
 }
 
-template <typename T>
-void
-putLittle(std::ostream& out, T value)
+/** Stores \a value at \a out in little- or big-endian byte order, whatever the host's
+ * order, and returns the next byte. */
+template <bool kBigEndian, typename T>
+char*
+store(char* out, T value)
 {
-  out.write(reinterpret_cast<const char*>(&value), sizeof(T));
+  static_assert(std::is_arithmetic<T>::value, "numbers only");
+  using Bits = std::conditional_t<
+      sizeof(T) == 1,
+      std::uint8_t,
+      std::conditional_t<
+          sizeof(T) == 2,
+          std::uint16_t,
+          std::conditional_t<sizeof(T) == 4, std::uint32_t, std::uint64_t>>>;
+  Bits bits;
+  std::memcpy(&bits, &value, sizeof(T));
+  for (std::size_t i = 0; i < sizeof(T); ++i) {
+    const std::size_t shift = 8 * (kBigEndian ? sizeof(T) - 1 - i : i);
+    out[i] = static_cast<char>((bits >> shift) & 0xffu);
+  }
+  return out + sizeof(T);
 }
 
 template <typename T>
-void
-putBig(std::ostream& out, T value)
+char*
+putLittle(char* out, T value)
 {
-  char bytes[sizeof(T)];
-  std::memcpy(bytes, &value, sizeof(T));
-  for (std::size_t i = sizeof(T); i-- > 0;)
-    out.put(bytes[i]);
+  return store<false>(out, value);
+}
+
+template <typename T>
+char*
+putBig(char* out, T value)
+{
+  return store<true>(out, value);
+}
+
+/** Writes \a count records of \a size bytes each, record i made by fill(i, its first
+ * byte): a block of records at a time, filled on \a threads threads (the bytes do not
+ * depend on them), then written in one call. */
+template <typename Fill>
+void
+writeRecords(std::ostream& out,
+             std::size_t count,
+             std::size_t size,
+             int threads,
+             const Fill& fill)
+{
+  const std::size_t per_block = std::max<std::size_t>(1, (std::size_t{1} << 22) / size);
+  std::vector<char> block(std::min(count, per_block) * size);
+  for (std::size_t first = 0; first < count && out; first += per_block) {
+    const auto n = static_cast<std::ptrdiff_t>(std::min(per_block, count - first));
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(threads) schedule(static) if (n >= 16384)
+#endif
+    for (std::ptrdiff_t i = 0; i < n; ++i)
+      fill(first + static_cast<std::size_t>(i), block.data() + i * size);
+    out.write(block.data(), static_cast<std::streamsize>(n) * size);
+  }
+  static_cast<void>(threads); // without OpenMP
+}
+
+/** The colour of every label's interior triangles (segmentColor()), looked up instead
+ * of computed per triangle. */
+std::vector<Rgb>
+labelColors(const SegmentedMesh& mesh)
+{
+  std::uint32_t max_label = 0;
+  for (const auto l : mesh.labels)
+    max_label = std::max(max_label, l);
+  std::vector<Rgb> colors(std::size_t{max_label} + 1);
+  for (std::uint32_t l = 0; l <= max_label; ++l)
+    colors[l] = segmentColor(l);
+  return colors;
+}
+
+/** triangleColor() of triangle \a t, from the table of labelColors(). */
+const Rgb&
+faceColor(const SegmentedMesh& mesh, const std::vector<Rgb>& colors, std::size_t t)
+{
+  static const Rgb kWhite =
+      triangleColor(0, pcl::selective_seg::TriangleClass::InvalidEdge);
+  return mesh.classes[t] == pcl::selective_seg::TriangleClass::Interior
+             ? colors[mesh.labels[t]]
+             : kWhite;
 }
 
 std::string
@@ -184,30 +263,34 @@ writeLabeledCloud(const std::string& path, const pcl::PointCloud<pcl::PointXYZL>
 bool
 writeMeshPly(const std::string& path,
              const pcl::PointCloud<pcl::PointXYZ>& cloud,
-             const SegmentedMesh& mesh)
+             const SegmentedMesh& mesh,
+             int threads)
 {
   const CompactMesh m = compact(mesh, cloud.size());
+  const std::vector<Rgb> colors = labelColors(mesh);
   std::ofstream out(path, std::ios::binary);
   out << "ply\nformat binary_little_endian 1.0\n"
       << "comment pcl_selective_seg segmented mesh: edge triangles white\n"
       << "element vertex " << m.points.size() << "\n"
       << "property float x\nproperty float y\nproperty float z\n"
-      << "element face " << m.faces.size() << "\n"
+      << "element face " << mesh.triangles.size() << "\n"
       << "property list uchar int vertex_indices\n"
       << "property uchar red\nproperty uchar green\nproperty uchar blue\n"
       << "property uint label\nproperty uchar class\nend_header\n";
-  for (const auto i : m.points)
+  writeRecords(out, m.points.size(), 12, threads, [&](std::size_t v, char* p) {
     for (int k = 0; k < 3; ++k)
-      putLittle(out, cloud[i].data[k]);
-  for (std::size_t t = 0; t < m.faces.size(); ++t) {
-    putLittle<std::uint8_t>(out, 3);
-    for (const auto v : m.faces[t])
-      putLittle<std::int32_t>(out, static_cast<std::int32_t>(v));
-    for (const auto c : triangleColor(mesh.labels[t], mesh.classes[t]))
-      putLittle(out, c);
-    putLittle<std::uint32_t>(out, mesh.labels[t]);
-    putLittle<std::uint8_t>(out, static_cast<std::uint8_t>(mesh.classes[t]));
-  }
+      p = putLittle(p, cloud[m.points[v]].data[k]);
+  });
+  // Per face: 3, its vertices, red, green, blue, label, class.
+  writeRecords(out, mesh.triangles.size(), 21, threads, [&](std::size_t t, char* p) {
+    p = putLittle<std::uint8_t>(p, 3);
+    for (const auto v : m.face(mesh, t))
+      p = putLittle<std::int32_t>(p, static_cast<std::int32_t>(v));
+    for (const auto c : faceColor(mesh, colors, t))
+      p = putLittle(p, c);
+    p = putLittle<std::uint32_t>(p, mesh.labels[t]);
+    putLittle<std::uint8_t>(p, static_cast<std::uint8_t>(mesh.classes[t]));
+  });
   out.close();
   return static_cast<bool>(out);
 }
@@ -215,32 +298,38 @@ writeMeshPly(const std::string& path,
 bool
 writeMeshVtk(const std::string& path,
              const pcl::PointCloud<pcl::PointXYZ>& cloud,
-             const SegmentedMesh& mesh)
+             const SegmentedMesh& mesh,
+             int threads)
 {
   const CompactMesh m = compact(mesh, cloud.size());
-  const std::size_t n = m.faces.size();
+  const std::vector<Rgb> colors = labelColors(mesh);
+  const std::size_t n = mesh.triangles.size();
   std::ofstream out(path, std::ios::binary);
   out << "# vtk DataFile Version 3.0\npcl_selective_seg segmented mesh\nBINARY\n"
       << "DATASET POLYDATA\nPOINTS " << m.points.size() << " float\n";
-  for (const auto i : m.points)
+  writeRecords(out, m.points.size(), 12, threads, [&](std::size_t v, char* p) {
     for (int k = 0; k < 3; ++k)
-      putBig(out, cloud[i].data[k]);
+      p = putBig(p, cloud[m.points[v]].data[k]);
+  });
   out << "\nPOLYGONS " << n << " " << 4 * n << "\n";
-  for (const auto& f : m.faces) {
-    putBig<std::int32_t>(out, 3);
-    for (const auto v : f)
-      putBig<std::int32_t>(out, static_cast<std::int32_t>(v));
-  }
+  writeRecords(out, n, 16, threads, [&](std::size_t t, char* p) {
+    p = putBig<std::int32_t>(p, 3);
+    for (const auto v : m.face(mesh, t))
+      p = putBig<std::int32_t>(p, static_cast<std::int32_t>(v));
+  });
   out << "\nCELL_DATA " << n << "\nCOLOR_SCALARS colors 3\n";
-  for (std::size_t t = 0; t < n; ++t)
-    for (const auto c : triangleColor(mesh.labels[t], mesh.classes[t]))
-      out.put(static_cast<char>(c));
+  writeRecords(out, n, 3, threads, [&](std::size_t t, char* p) {
+    for (const auto c : faceColor(mesh, colors, t))
+      p = putBig(p, c);
+  });
   out << "\nSCALARS label unsigned_int 1\nLOOKUP_TABLE default\n";
-  for (std::size_t t = 0; t < n; ++t)
-    putBig<std::uint32_t>(out, mesh.labels[t]);
+  writeRecords(out, n, 4, threads, [&](std::size_t t, char* p) {
+    putBig<std::uint32_t>(p, mesh.labels[t]);
+  });
   out << "\nSCALARS class unsigned_char 1\nLOOKUP_TABLE default\n";
-  for (std::size_t t = 0; t < n; ++t)
-    out.put(static_cast<char>(mesh.classes[t]));
+  writeRecords(out, n, 1, threads, [&](std::size_t t, char* p) {
+    putBig<std::uint8_t>(p, static_cast<std::uint8_t>(mesh.classes[t]));
+  });
   out << "\n";
   out.close();
   return static_cast<bool>(out);

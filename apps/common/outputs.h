@@ -48,16 +48,19 @@ bool writeLabeledCloud(const std::string& path,
 
 /** \brief The segmented mesh as binary PLY: the vertices the triangles use, and per
  * face its vertex indices, an RGB colour (segment hue; edge triangles white), its label
- * and its class (0 interior, 1 valid edge, 2 invalid edge). */
+ * and its class (0 interior, 1 valid edge, 2 invalid edge). The bytes are made in
+ * blocks on \a threads threads (the file does not depend on them). */
 bool writeMeshPly(const std::string& path,
                   const pcl::PointCloud<pcl::PointXYZ>& cloud,
-                  const pcl::selective_seg::SegmentedMesh& mesh);
+                  const pcl::selective_seg::SegmentedMesh& mesh,
+                  int threads = 1);
 
 /** \brief The same mesh as legacy binary VTK polydata, with the colours, labels and
- * classes as cell data. */
+ * classes as cell data (made on \a threads threads, as writeMeshPly()). */
 bool writeMeshVtk(const std::string& path,
                   const pcl::PointCloud<pcl::PointXYZ>& cloud,
-                  const pcl::selective_seg::SegmentedMesh& mesh);
+                  const pcl::selective_seg::SegmentedMesh& mesh,
+                  int threads = 1);
 
 /** \brief The octree leaves as a PCD, one point per leaf: x y z (centre, cloud frame)
  * size depth label normal_x normal_y normal_z sigma_theta sigma_phi num_points. */

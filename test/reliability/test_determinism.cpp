@@ -141,14 +141,14 @@ TEST(Determinism, ToolOutputsAreByteIdentical)
   };
   std::map<std::string, std::string> first;
   for (const int threads : {1, 2, 1}) {
-    const std::string command = "OMP_NUM_THREADS=" + std::to_string(threads) + " '" +
-                                tool + "' '" + scan + "' -ignore_viewpoint -o '" +
-                                (dir / "labels.pcd").string() + "' -mesh_ply '" +
-                                (dir / "mesh.ply").string() + "' -leaves '" +
-                                (dir / "leaves.pcd").string() + "' > /dev/null 2>&1";
+    const std::string command =
+        "OMP_NUM_THREADS=" + std::to_string(threads) + " '" + tool + "' '" + scan +
+        "' -ignore_viewpoint -o '" + (dir / "labels.pcd").string() + "' -mesh_ply '" +
+        (dir / "mesh.ply").string() + "' -mesh_vtk '" + (dir / "mesh.vtk").string() +
+        "' -leaves '" + (dir / "leaves.pcd").string() + "' > /dev/null 2>&1";
     const int status = std::system(command.c_str());
     ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << command;
-    for (const char* name : {"labels.pcd", "mesh.ply", "leaves.pcd"}) {
+    for (const char* name : {"labels.pcd", "mesh.ply", "mesh.vtk", "leaves.pcd"}) {
       const std::string content = read(dir / name);
       ASSERT_FALSE(content.empty()) << name;
       if (first.count(name)) {
