@@ -369,7 +369,9 @@ writeOutputs(const Options& opt,
       write(opt.leaves,
             [&](const std::string& f) { return writeLeaves(f, r.leaves); }) &&
       write(opt.json,
-            [&](const std::string& f) { return writeSummaryJson(f, info, r); }) &&
+            [&](const std::string& f) {
+              return writeSummaryJson(f, info, r, threads);
+            }) &&
       write(opt.roi_json, [&](const std::string& f) {
         return writeRegionsJson(f, opt.input, opt.roi, stats, regions);
       });

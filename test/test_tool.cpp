@@ -477,6 +477,47 @@ TEST(MeshWriters, LargeMeshSameBytesForAnyThreadCount)
   fs::remove_all(dir);
 }
 
+// The JSON summary's segments: the numbers as the stream printed them (%.9g), in label
+// order, the same text on one thread and on three (several blocks of segments).
+TEST(SummaryJson, SegmentLinesKnownTextForAnyThreadCount)
+{
+  pcl::selective_seg::SegmentationResult r;
+  for (std::uint32_t l = 1; l <= 10000; ++l) {
+    pcl::selective_seg::Segment s;
+    s.label = l;
+    s.num_points = 5 + l;
+    s.num_leaves = 2;
+    s.area = 0.1 * l;
+    s.normal = Eigen::Vector3f(0.1f, -0.5f, 1.0f);
+    r.segments.push_back(s);
+  }
+  selseg_apps::RunInfo info;
+  info.input = "scan \"1\".pcd";
+  const auto dir =
+      fs::temp_directory_path() / ("selseg_json_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const std::string one = (dir / "one.json").string(),
+                    three = (dir / "three.json").string();
+  ASSERT_TRUE(selseg_apps::writeSummaryJson(one, info, r, 1));
+  ASSERT_TRUE(selseg_apps::writeSummaryJson(three, info, r, 3));
+  const std::string text = fileBytes(one);
+  EXPECT_TRUE(text == fileBytes(three));
+  EXPECT_NE(text.find("\"input\": \"scan \\\"1\\\".pcd\""), std::string::npos);
+  EXPECT_NE(
+      text.find("\"segments\": [\n    {\"label\": 1, \"points\": 6, \"leaves\": 2, "
+                "\"area_m2\": 0.1, \"normal\": [0.100000001, -0.5, 1]},\n"),
+      std::string::npos);
+  EXPECT_NE(text.find(",\n    {\"label\": 4097, \"points\": 4102, \"leaves\": 2, "
+                      "\"area_m2\": 409.7, "),
+            std::string::npos);
+  const std::string last =
+      "{\"label\": 10000, \"points\": 10005, \"leaves\": 2, "
+      "\"area_m2\": 1000, \"normal\": [0.100000001, -0.5, 1]}\n  ]\n}\n";
+  ASSERT_GE(text.size(), last.size());
+  EXPECT_EQ(text.substr(text.size() - last.size()), last);
+  fs::remove_all(dir);
+}
+
 int
 main(int argc, char** argv)
 {

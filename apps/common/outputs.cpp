@@ -366,7 +366,8 @@ writeLeaves(const std::string& path,
 bool
 writeSummaryJson(const std::string& path,
                  const RunInfo& info,
-                 const pcl::selective_seg::SegmentationResult& r)
+                 const pcl::selective_seg::SegmentationResult& r,
+                 int threads)
 {
   const auto& p = info.parameters;
   const auto& c = r.counts;
@@ -395,13 +396,40 @@ writeSummaryJson(const std::string& path,
       << ", \"normals\": " << t.normals << ", \"octree\": " << t.octree
       << ", \"merge\": " << t.merge << ", \"total\": " << t.total
       << "},\n  \"segments\": [";
-  for (std::size_t s = 0; s < r.segments.size(); ++s) {
-    const auto& seg = r.segments[s];
-    out << (s ? ",\n    " : "\n    ") << "{\"label\": " << seg.label
-        << ", \"points\": " << seg.num_points << ", \"leaves\": " << seg.num_leaves
-        << ", \"area_m2\": " << seg.area << ", \"normal\": [" << seg.normal.x() << ", "
-        << seg.normal.y() << ", " << seg.normal.z() << "]}";
+  // One line per segment, formatted in blocks on the threads (%.9g is what the stream
+  // prints at precision 9), then written in order.
+  const std::size_t num_segments = r.segments.size();
+  constexpr std::size_t kPerBlock = 4096;
+  const std::size_t num_blocks = (num_segments + kPerBlock - 1) / kPerBlock;
+  std::vector<std::string> blocks(num_blocks);
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 1) if (num_blocks > 1)
+#endif
+  for (std::ptrdiff_t b = 0; b < static_cast<std::ptrdiff_t>(num_blocks); ++b) {
+    std::string& text = blocks[static_cast<std::size_t>(b)];
+    const std::size_t first = static_cast<std::size_t>(b) * kPerBlock;
+    for (std::size_t s = first; s < std::min(num_segments, first + kPerBlock); ++s) {
+      const auto& seg = r.segments[s];
+      char line[320];
+      const int length = std::snprintf(
+          line,
+          sizeof(line),
+          "%s{\"label\": %u, \"points\": %zu, \"leaves\": %zu, \"area_m2\": %.9g, "
+          "\"normal\": [%.9g, %.9g, %.9g]}",
+          s ? ",\n    " : "\n    ",
+          static_cast<unsigned>(seg.label),
+          seg.num_points,
+          seg.num_leaves,
+          seg.area,
+          static_cast<double>(seg.normal.x()),
+          static_cast<double>(seg.normal.y()),
+          static_cast<double>(seg.normal.z()));
+      text.append(line, static_cast<std::size_t>(std::max(0, length)));
+    }
   }
+  static_cast<void>(threads); // without OpenMP
+  for (const auto& text : blocks)
+    out << text;
   out << "\n  ]\n}\n";
   out.close();
   return static_cast<bool>(out);

@@ -76,9 +76,11 @@ struct RunInfo {
 };
 
 /** \brief A JSON summary: input, parameters, counts, timings and every segment's size,
- * normal, area and leaf count. */
+ * normal, area and leaf count (formatted on \a threads threads; the file does not
+ * depend on them). */
 bool writeSummaryJson(const std::string& path,
                       const RunInfo& info,
-                      const pcl::selective_seg::SegmentationResult& result);
+                      const pcl::selective_seg::SegmentationResult& result,
+                      int threads = 1);
 
 } // namespace selseg_apps
