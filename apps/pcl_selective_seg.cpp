@@ -356,7 +356,7 @@ writeOutputs(const Options& opt,
   const bool ok =
       write(opt.labels,
             [&](const std::string& f) {
-              return writeLabeledCloud(f, *seg.getLabeledCloud());
+              return writeLabeledCloud(f, cloud, r.labels, threads);
             }) &&
       write(opt.mesh_ply,
             [&](const std::string& f) {
@@ -419,6 +419,8 @@ segment(const Options& opt)
     print_error("Segmentation failed (reason above).\n");
     return kRuntimeError;
   }
+  // The outputs come from the result: the point lists are freed for the writers.
+  std::vector<pcl::PointIndices>().swap(segments);
   printTimings(seg.getResult());
   printSummary(seg.getResult());
   timer.tic();

@@ -15,9 +15,11 @@
 #include <pcl/io/ply_io.h>
 
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <map>
 #include <sstream>
 #include <string>
@@ -515,6 +517,67 @@ TEST(SummaryJson, SegmentLinesKnownTextForAnyThreadCount)
       "\"area_m2\": 1000, \"normal\": [0.100000001, -0.5, 1]}\n  ]\n}\n";
   ASSERT_GE(text.size(), last.size());
   EXPECT_EQ(text.substr(text.size() - last.size()), last);
+  fs::remove_all(dir);
+}
+
+// The labeled cloud: PCL reads back the input's points, layout and viewpoint with the
+// labels; the header is the one PCL's own writer makes; the same bytes on one thread
+// and on three (several compressed chunks).
+TEST(LabeledCloudWriter, PclReadsTheInputWithItsLabels)
+{
+  // An organized 400 x 300 cloud (1.9 MB of planes: two chunks) with invalid points.
+  pcl::PointCloud<pcl::PointXYZ> cloud(400, 300);
+  std::vector<std::uint32_t> labels(cloud.size());
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const float u = static_cast<float>(i % 400), v = static_cast<float>(i / 400);
+    cloud[i] = pcl::PointXYZ(0.01f * u, 0.02f * v, 1.0f + 0.001f * (u + v));
+    labels[i] = static_cast<std::uint32_t>((i * 7919) % 1000);
+    if (i % 37 == 0) {
+      cloud[i].x = cloud[i].y = cloud[i].z = std::numeric_limits<float>::quiet_NaN();
+      labels[i] = 0;
+    }
+  }
+  cloud.is_dense = false;
+  cloud.sensor_origin_ = Eigen::Vector4f(0.5f, -0.25f, 2.0f, 0.0f);
+  cloud.sensor_orientation_ = Eigen::Quaternionf(0.5f, 0.5f, -0.5f, 0.5f);
+  const auto dir =
+      fs::temp_directory_path() / ("selseg_labels_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const std::string one = (dir / "one.pcd").string(),
+                    three = (dir / "three.pcd").string();
+  ASSERT_TRUE(selseg_apps::writeLabeledCloud(one, cloud, labels, 1));
+  ASSERT_TRUE(selseg_apps::writeLabeledCloud(three, cloud, labels, 3));
+  EXPECT_TRUE(fileBytes(one) == fileBytes(three));
+
+  pcl::PointCloud<pcl::PointXYZL> read;
+  ASSERT_EQ(pcl::io::loadPCDFile(one, read), 0);
+  ASSERT_EQ(read.width, cloud.width);
+  ASSERT_EQ(read.height, cloud.height);
+  EXPECT_EQ(read.sensor_origin_, cloud.sensor_origin_);
+  EXPECT_EQ(read.sensor_orientation_.coeffs(), cloud.sensor_orientation_.coeffs());
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    ASSERT_EQ(std::memcmp(read[i].data, cloud[i].data, 12), 0) << i;
+    ASSERT_EQ(read[i].label, labels[i]) << i;
+  }
+
+  // PCL's writer, on the same cloud: the same header up to the data.
+  pcl::PointCloud<pcl::PointXYZL> labeled;
+  pcl::copyPointCloud(cloud, labeled);
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    labeled[i].label = labels[i];
+  const std::string pcl_file = (dir / "pcl.pcd").string();
+  ASSERT_EQ(pcl::io::savePCDFileBinaryCompressed(pcl_file, labeled), 0);
+  const auto header = [](const std::string& bytes) {
+    return bytes.substr(0, bytes.find("DATA binary_compressed\n"));
+  };
+  const std::string ours = fileBytes(one);
+  ASSERT_NE(ours.find("DATA binary_compressed\n"), std::string::npos);
+  EXPECT_EQ(header(ours), header(fileBytes(pcl_file)));
+
+  // Labels that do not match the cloud: nothing is claimed written.
+  labels.pop_back();
+  EXPECT_FALSE(
+      selseg_apps::writeLabeledCloud((dir / "bad.pcd").string(), cloud, labels));
   fs::remove_all(dir);
 }
 

@@ -7,6 +7,7 @@
 #define PCL_NO_PRECOMPILE
 #include "outputs.h"
 
+#include <pcl/io/lzf.h>
 #include <pcl/io/pcd_io.h>
 #include <pcl/point_types.h>
 #include <pcl/register_point_struct.h>
@@ -23,7 +24,6 @@
 #include <type_traits>
 
 #include "segment_colors.h"
-
 #include <unistd.h>
 
 namespace selseg_apps {
@@ -250,14 +250,91 @@ OutputTransaction::commit(std::string& error)
 }
 
 bool
-writeLabeledCloud(const std::string& path, const pcl::PointCloud<pcl::PointXYZL>& cloud)
+writeLabeledCloud(const std::string& path,
+                  const pcl::PointCloud<pcl::PointXYZ>& cloud,
+                  const std::vector<std::uint32_t>& labels,
+                  int threads)
 {
-  try {
-    if (pcl::io::savePCDFileBinaryCompressed(path, cloud) == 0)
-      return true;
-  } catch (const pcl::IOException&) {
+  const std::size_t n = cloud.size();
+  const std::size_t data_size = 16 * n; // the planes x, y, z, label
+  if (labels.size() != n || data_size > std::numeric_limits<std::uint32_t>::max())
+    return false;
+  // PCL's header for x y z label with the input's width, height and viewpoint, made for
+  // a cloud of that shape without points; only its POINTS line depends on them.
+  pcl::PointCloud<pcl::PointXYZL> shape;
+  shape.width = cloud.width;
+  shape.height = cloud.height;
+  shape.sensor_origin_ = cloud.sensor_origin_;
+  shape.sensor_orientation_ = cloud.sensor_orientation_;
+  std::string header = pcl::PCDWriter::generateHeader(shape);
+  const std::string no_points = "POINTS 0\n";
+  if (header.size() < no_points.size() ||
+      header.compare(header.size() - no_points.size(), no_points.size(), no_points) !=
+          0)
+    return false;
+  header.resize(header.size() - no_points.size());
+  header += "POINTS " + std::to_string(n) + "\nDATA binary_compressed\n";
+
+  // The data: the planes as PCL lays them out, in chunks of kChunk bytes, each
+  // compressed on its own (a concatenation of LZF streams is the LZF stream of the
+  // concatenated data) on the threads, a batch at a time, and written in order. The
+  // chunks do not depend on the thread count, so neither do the bytes.
+  constexpr std::size_t kChunk = std::size_t{1} << 20;
+  const std::size_t num_chunks = (data_size + kChunk - 1) / kChunk;
+  const auto batch = static_cast<std::size_t>(std::max(1, threads));
+  const std::size_t chunk_bytes = std::min(kChunk, data_size);
+  std::vector<std::vector<char>> in(batch, std::vector<char>(chunk_bytes));
+  std::vector<std::vector<char>> packed(
+      batch, std::vector<char>(chunk_bytes + chunk_bytes / 2 + 16));
+  std::vector<unsigned int> packed_size(batch);
+  const auto fill = [&](std::size_t chunk, char* out) {
+    // Byte offsets are multiples of 4: whole values.
+    const std::size_t first = chunk * kChunk / 4;
+    const std::size_t end = std::min(data_size, (chunk + 1) * kChunk) / 4;
+    std::size_t plane = first / n, i = first % n;
+    for (std::size_t e = first; e < end; ++e, out += 4) {
+      if (plane < 3)
+        std::memcpy(out, &cloud[i].data[plane], 4);
+      else
+        std::memcpy(out, &labels[i], 4);
+      if (++i == n) {
+        i = 0;
+        ++plane;
+      }
+    }
+    return (end - first) * 4;
+  };
+  std::ofstream out(path, std::ios::binary);
+  out << header;
+  const auto sizes_at = out.tellp();
+  const std::uint32_t uncompressed = static_cast<std::uint32_t>(data_size);
+  std::uint32_t compressed = 0;
+  out.write(reinterpret_cast<const char*>(&compressed), 4);
+  out.write(reinterpret_cast<const char*>(&uncompressed), 4);
+  bool ok = true;
+  for (std::size_t first = 0; first < num_chunks && ok && out; first += batch) {
+    const auto count = static_cast<std::ptrdiff_t>(std::min(batch, num_chunks - first));
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(threads) schedule(static, 1) if (count > 1)
+#endif
+    for (std::ptrdiff_t k = 0; k < count; ++k) {
+      const std::size_t length = fill(first + k, in[k].data());
+      packed_size[k] = pcl::lzfCompress(in[k].data(),
+                                        static_cast<unsigned int>(length),
+                                        packed[k].data(),
+                                        static_cast<unsigned int>(packed[k].size()));
+    }
+    for (std::ptrdiff_t k = 0; k < count && ok; ++k) {
+      ok = packed_size[k] > 0 && std::uint64_t{compressed} + packed_size[k] <=
+                                     std::numeric_limits<std::uint32_t>::max();
+      compressed += packed_size[k];
+      out.write(packed[k].data(), packed_size[k]);
+    }
   }
-  return false;
+  out.seekp(sizes_at);
+  out.write(reinterpret_cast<const char*>(&compressed), 4);
+  out.close();
+  return ok && static_cast<bool>(out);
 }
 
 bool
@@ -397,39 +474,44 @@ writeSummaryJson(const std::string& path,
       << ", \"merge\": " << t.merge << ", \"total\": " << t.total
       << "},\n  \"segments\": [";
   // One line per segment, formatted in blocks on the threads (%.9g is what the stream
-  // prints at precision 9), then written in order.
+  // prints at precision 9), a block per thread at a time, written in order.
   const std::size_t num_segments = r.segments.size();
   constexpr std::size_t kPerBlock = 4096;
   const std::size_t num_blocks = (num_segments + kPerBlock - 1) / kPerBlock;
-  std::vector<std::string> blocks(num_blocks);
+  const auto batch = static_cast<std::size_t>(std::max(1, threads));
+  std::vector<std::string> blocks(batch);
+  for (std::size_t first_block = 0; first_block < num_blocks; first_block += batch) {
+    const auto count =
+        static_cast<std::ptrdiff_t>(std::min(batch, num_blocks - first_block));
 #ifdef _OPENMP
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 1) if (num_blocks > 1)
+#pragma omp parallel for num_threads(threads) schedule(static, 1) if (count > 1)
 #endif
-  for (std::ptrdiff_t b = 0; b < static_cast<std::ptrdiff_t>(num_blocks); ++b) {
-    std::string& text = blocks[static_cast<std::size_t>(b)];
-    const std::size_t first = static_cast<std::size_t>(b) * kPerBlock;
-    for (std::size_t s = first; s < std::min(num_segments, first + kPerBlock); ++s) {
-      const auto& seg = r.segments[s];
-      char line[320];
-      const int length = std::snprintf(
-          line,
-          sizeof(line),
-          "%s{\"label\": %u, \"points\": %zu, \"leaves\": %zu, \"area_m2\": %.9g, "
-          "\"normal\": [%.9g, %.9g, %.9g]}",
-          s ? ",\n    " : "\n    ",
-          static_cast<unsigned>(seg.label),
-          seg.num_points,
-          seg.num_leaves,
-          seg.area,
-          static_cast<double>(seg.normal.x()),
-          static_cast<double>(seg.normal.y()),
-          static_cast<double>(seg.normal.z()));
-      text.append(line, static_cast<std::size_t>(std::max(0, length)));
+    for (std::ptrdiff_t k = 0; k < count; ++k) {
+      std::string& text = blocks[static_cast<std::size_t>(k)];
+      text.clear();
+      const std::size_t first = (first_block + static_cast<std::size_t>(k)) * kPerBlock;
+      for (std::size_t s = first; s < std::min(num_segments, first + kPerBlock); ++s) {
+        const auto& seg = r.segments[s];
+        char line[320];
+        const int length = std::snprintf(
+            line,
+            sizeof(line),
+            "%s{\"label\": %u, \"points\": %zu, \"leaves\": %zu, \"area_m2\": %.9g, "
+            "\"normal\": [%.9g, %.9g, %.9g]}",
+            s ? ",\n    " : "\n    ",
+            static_cast<unsigned>(seg.label),
+            seg.num_points,
+            seg.num_leaves,
+            seg.area,
+            static_cast<double>(seg.normal.x()),
+            static_cast<double>(seg.normal.y()),
+            static_cast<double>(seg.normal.z()));
+        text.append(line, static_cast<std::size_t>(std::max(0, length)));
+      }
     }
+    for (std::ptrdiff_t k = 0; k < count; ++k)
+      out << blocks[static_cast<std::size_t>(k)];
   }
-  static_cast<void>(threads); // without OpenMP
-  for (const auto& text : blocks)
-    out << text;
   out << "\n  ]\n}\n";
   out.close();
   return static_cast<bool>(out);

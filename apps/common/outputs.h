@@ -42,9 +42,14 @@ private:
 
 // Each writer returns false when the file cannot be written completely.
 
-/** \brief The labeled cloud (x y z label), input size, order and layout, binary PCD. */
+/** \brief The labeled cloud (x y z label; the input's size, order, layout and
+ * viewpoint) as a binary_compressed PCD that PCL reads, from the input and a label per
+ * point. Compressed in chunks on \a threads threads (the bytes do not depend on them)
+ * and written as they are made: no labeled copy of the cloud is held. */
 bool writeLabeledCloud(const std::string& path,
-                       const pcl::PointCloud<pcl::PointXYZL>& cloud);
+                       const pcl::PointCloud<pcl::PointXYZ>& cloud,
+                       const std::vector<std::uint32_t>& labels,
+                       int threads = 1);
 
 /** \brief The segmented mesh as binary PLY: the vertices the triangles use, and per
  * face its vertex indices, an RGB colour (segment hue; edge triangles white), its label
