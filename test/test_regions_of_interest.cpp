@@ -18,7 +18,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <limits>
 #include <random>
+#include <string>
+#include <utility>
+#include <vector>
 
 namespace sim = pcl::selective_seg::simulation;
 using namespace pcl::selective_seg;
@@ -169,6 +174,58 @@ TEST(RegionsOfInterest, ParametersNameTheBadOne)
   EXPECT_FALSE(computeRegionsOfInterest(
       g.result, g.tri, Eigen::Affine3f::Identity(), p, regions));
   EXPECT_TRUE(regions.empty());
+}
+
+// Every parameter out of its range is refused, and the message names it.
+TEST(RegionsOfInterest, EveryBadParameterIsNamed)
+{
+  using P = RegionOfInterestParameters;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  const std::vector<std::pair<std::string, std::function<void(P&)>>> cases = {
+      {"leaf_sigma_threshold", [&](P& p) { p.leaf_sigma_threshold = nan; }},
+      {"min_side_angle", [](P& p) { p.min_side_angle = 4.0; }},
+      {"min_side_angle", [](P& p) { p.min_side_angle = -0.1; }},
+      {"side_confidence", [](P& p) { p.side_confidence = 1.0; }},
+      {"edge_on_angle", [](P& p) { p.edge_on_angle = 0.0; }},
+      {"edge_on_angle", [](P& p) { p.edge_on_angle = 1.6; }},
+      {"sparse_factor", [](P& p) { p.sparse_factor = 0.5; }},
+      {"sparse_factor", [&](P& p) { p.sparse_factor = inf; }},
+      {"min_component_vertices", [](P& p) { p.min_component_vertices = 0; }},
+      {"max_window_size", [](P& p) { p.max_window_size = 4.0; }},
+      {"min_window_size", [](P& p) { p.min_window_size = p.max_window_size * 2.0; }},
+      {"min_window_size", [](P& p) { p.min_window_size = -0.01; }},
+      {"margin", [](P& p) { p.margin = -0.001; }},
+      {"margin_spacings", [&](P& p) { p.margin_spacings = inf; }},
+      {"merge_area_ratio", [&](P& p) { p.merge_area_ratio = nan; }},
+      {"target_step", [](P& p) { p.target_step = -0.001; }},
+      {"refinement_factor", [](P& p) { p.refinement_factor = 1.0; }},
+      {"min_refinement", [](P& p) { p.min_refinement = 0.5; }},
+      {"transition_weight", [](P& p) { p.transition_weight = -1.0; }},
+      {"leaf_weight", [&](P& p) { p.leaf_weight = nan; }},
+      {"valid_edge_weight", [](P& p) { p.valid_edge_weight = -1.0; }},
+      {"small_segment_weight", [&](P& p) { p.small_segment_weight = inf; }},
+      {"sparse_weight", [](P& p) { p.sparse_weight = -0.5; }},
+      {"max_solid_angle", [](P& p) { p.max_solid_angle = -1.0; }},
+      {"sample_yield", [](P& p) { p.sample_yield = 0.0; }},
+  };
+  for (const auto& c : cases) {
+    P p;
+    c.second(p);
+    std::string why;
+    EXPECT_FALSE(p.validate(&why)) << c.first;
+    EXPECT_NE(why.find(c.first), std::string::npos) << c.first << ": " << why;
+  }
+  // The edges of the ranges are valid.
+  P p;
+  p.min_side_angle = M_PI;
+  p.edge_on_angle = M_PI / 2;
+  p.sparse_factor = 1.0;
+  p.min_window_size = p.max_window_size;
+  p.min_refinement = 1.0;
+  p.sample_yield = 1.0;
+  std::string why;
+  EXPECT_TRUE(p.validate(&why)) << why;
 }
 
 TEST(RegionsOfInterest, EmptyAndMismatchedInput)
@@ -721,6 +778,31 @@ TEST_F(CubeRegions, FinelyScannedEvidenceIsSpent)
   ASSERT_TRUE(computeRegionsOfInterest(*seg_, p, regions, &coarse));
   EXPECT_LT(coarse.transition_vertices * 10, fine.transition_vertices);
   EXPECT_LT(coarse.candidates * 5, fine.candidates);
+}
+
+// min_refinement: a window is proposed only when its suggested step refines its current
+// spacing at least that much. With the step a third of the spacing, asking for 2.5
+// keeps every window, asking for 3.5 drops every one as already fine.
+TEST_F(CubeRegions, WindowsAlreadyFineEnoughAreDropped)
+{
+  RegionOfInterestParameters p = noBudget();
+  p.target_step = 0.0;
+  p.refinement_factor = 3.0;
+  p.min_refinement = 2.5;
+  std::vector<RegionOfInterest> regions;
+  RegionOfInterestStats kept, dropped;
+  ASSERT_TRUE(computeRegionsOfInterest(*seg_, p, regions, &kept));
+  ASSERT_GT(kept.candidates, 0u);
+  EXPECT_EQ(kept.already_fine, 0u);
+  EXPECT_EQ(kept.selected, kept.candidates);
+  for (const auto& r : regions)
+    EXPECT_NEAR(r.suggested_step, r.current_step / 3.0, 1e-15 * r.current_step);
+  p.min_refinement = 3.5;
+  ASSERT_TRUE(computeRegionsOfInterest(*seg_, p, regions, &dropped));
+  EXPECT_EQ(dropped.candidates, kept.candidates);
+  EXPECT_EQ(dropped.already_fine, dropped.candidates);
+  EXPECT_EQ(dropped.selected, 0u);
+  EXPECT_TRUE(regions.empty());
 }
 
 TEST(RegionsOfInterest, ReasonNames)
