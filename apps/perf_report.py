@@ -109,7 +109,7 @@ def markdown(context, runs, rows, memory, load=None):
            "|---|---|---|---|---|---|---|---|"]
     for n, b, rg in rows:
         total = seconds(b)
-        ratio = f"{seconds(rg) / total:.1f}x" if rg else "-"
+        ratio = f"{seconds(rg) / total:.2f}x" if rg else "-"
         out.append(f"| {n:,} | {b['delaunay_s']:.4f} | {b['normals_s']:.4f} | "
                    f"{b['octree_s']:.4f} | {b['merge_s']:.4f} | {total:.4f} | "
                    f"{seconds(rg):.3f} | {ratio} |" if rg else "")
@@ -128,7 +128,7 @@ def markdown(context, runs, rows, memory, load=None):
             out.append(f"| {label} | {int(b['points']):,} | {b['delaunay_s']:.4f} | "
                        f"{b['normals_s']:.4f} | {b['octree_s']:.4f} | "
                        f"{b['merge_s']:.4f} | {seconds(b):.4f} | {seconds(rg):.3f} | "
-                       f"{seconds(rg) / seconds(b):.1f}x |")
+                       f"{seconds(rg) / seconds(b):.2f}x |")
     out += ["", "## Peak memory of the command-line tool", "",
             "`pcl_selective_seg SCAN.pcd -o LABELS.pcd` (load, segment, write the "
             "labeled cloud), peak resident memory of the process:", "", "| points | peak (MB) | bytes per point |",
