@@ -316,6 +316,30 @@ namespace {
 using pcl::selective_seg::SegmentedMesh;
 using pcl::selective_seg::TriangleClass;
 
+/** A fresh folder under the temporary directory, removed with everything in it when it
+ * goes out of scope (also when an assertion ends the test). */
+class ScratchDir {
+public:
+  explicit ScratchDir(const std::string& name)
+      : path_(fs::temp_directory_path() / (name + "_" + std::to_string(::getpid())))
+  {
+    fs::remove_all(path_);
+    fs::create_directories(path_);
+  }
+  ~ScratchDir()
+  {
+    std::error_code ignored;
+    fs::remove_all(path_, ignored);
+  }
+  ScratchDir(const ScratchDir&) = delete;
+  ScratchDir& operator=(const ScratchDir&) = delete;
+  /** The path of \a name in it. */
+  std::string file(const std::string& name) const { return (path_ / name).string(); }
+
+private:
+  fs::path path_;
+};
+
 /** Bytes of a 32-bit pattern, least significant first or last. */
 std::string
 bytes32(std::uint32_t bits, bool big_endian)
@@ -366,11 +390,8 @@ struct HandMadeMesh {
 TEST(MeshWriters, KnownBytesForAHandMadeMesh)
 {
   const HandMadeMesh m;
-  const auto dir =
-      fs::temp_directory_path() / ("selseg_writers_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  const std::string ply = (dir / "mesh.ply").string(),
-                    vtk = (dir / "mesh.vtk").string();
+  const ScratchDir dir("selseg_writers");
+  const std::string ply = dir.file("mesh.ply"), vtk = dir.file("mesh.vtk");
   ASSERT_TRUE(selseg_apps::writeMeshPly(ply, m.cloud, m.mesh));
   ASSERT_TRUE(selseg_apps::writeMeshVtk(vtk, m.cloud, m.mesh));
   const std::array<int, 4> order = {3, 1, 4, 2}; // output vertex -> input point
@@ -422,7 +443,6 @@ TEST(MeshWriters, KnownBytesForAHandMadeMesh)
   expected += "\nSCALARS class unsigned_char 1\nLOOKUP_TABLE default\n";
   expected += bytes8(0) + bytes8(1) + "\n";
   EXPECT_TRUE(fileBytes(vtk) == expected);
-  fs::remove_all(dir);
 }
 
 // A mesh of several blocks of faces: the same bytes on one thread and on three, and
@@ -446,13 +466,10 @@ TEST(MeshWriters, LargeMeshSameBytesForAnyThreadCount)
     mesh.labels.push_back(static_cast<std::uint32_t>(t % 97));
     mesh.classes.push_back(static_cast<TriangleClass>(t % 3));
   }
-  const auto dir = fs::temp_directory_path() /
-                   ("selseg_writers_large_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
+  const ScratchDir dir("selseg_writers_large");
+  const std::string ply = dir.file("mesh.ply"), vtk = dir.file("mesh.vtk");
   std::map<std::string, std::string> one;
   for (const int threads : {1, 3}) {
-    const std::string ply = (dir / "mesh.ply").string(),
-                      vtk = (dir / "mesh.vtk").string();
     ASSERT_TRUE(selseg_apps::writeMeshPly(ply, cloud, mesh, threads));
     ASSERT_TRUE(selseg_apps::writeMeshVtk(vtk, cloud, mesh, threads));
     for (const auto& path : {ply, vtk}) {
@@ -464,7 +481,7 @@ TEST(MeshWriters, LargeMeshSameBytesForAnyThreadCount)
     }
   }
   pcl::PolygonMesh read;
-  ASSERT_EQ(pcl::io::loadPLYFile((dir / "mesh.ply").string(), read), 0);
+  ASSERT_EQ(pcl::io::loadPLYFile(ply, read), 0);
   ASSERT_EQ(read.polygons.size(), mesh.triangles.size());
   ASSERT_EQ(read.cloud.width * read.cloud.height, cloud.size());
   pcl::PointCloud<pcl::PointXYZ> vertices;
@@ -476,7 +493,6 @@ TEST(MeshWriters, LargeMeshSameBytesForAnyThreadCount)
                 cloud[mesh.triangles[t][i]].getVector3fMap())
           << "face " << t << " corner " << i;
     }
-  fs::remove_all(dir);
 }
 
 // The JSON summary's segments: the numbers as the stream printed them (%.9g), in label
@@ -495,11 +511,8 @@ TEST(SummaryJson, SegmentLinesKnownTextForAnyThreadCount)
   }
   selseg_apps::RunInfo info;
   info.input = "scan \"1\".pcd";
-  const auto dir =
-      fs::temp_directory_path() / ("selseg_json_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  const std::string one = (dir / "one.json").string(),
-                    three = (dir / "three.json").string();
+  const ScratchDir dir("selseg_json");
+  const std::string one = dir.file("one.json"), three = dir.file("three.json");
   ASSERT_TRUE(selseg_apps::writeSummaryJson(one, info, r, 1));
   ASSERT_TRUE(selseg_apps::writeSummaryJson(three, info, r, 3));
   const std::string text = fileBytes(one);
@@ -517,7 +530,6 @@ TEST(SummaryJson, SegmentLinesKnownTextForAnyThreadCount)
       "\"area_m2\": 1000, \"normal\": [0.100000001, -0.5, 1]}\n  ]\n}\n";
   ASSERT_GE(text.size(), last.size());
   EXPECT_EQ(text.substr(text.size() - last.size()), last);
-  fs::remove_all(dir);
 }
 
 // The labeled cloud: PCL reads back the input's points, layout and viewpoint with the
@@ -540,11 +552,8 @@ TEST(LabeledCloudWriter, PclReadsTheInputWithItsLabels)
   cloud.is_dense = false;
   cloud.sensor_origin_ = Eigen::Vector4f(0.5f, -0.25f, 2.0f, 0.0f);
   cloud.sensor_orientation_ = Eigen::Quaternionf(0.5f, 0.5f, -0.5f, 0.5f);
-  const auto dir =
-      fs::temp_directory_path() / ("selseg_labels_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  const std::string one = (dir / "one.pcd").string(),
-                    three = (dir / "three.pcd").string();
+  const ScratchDir dir("selseg_labels");
+  const std::string one = dir.file("one.pcd"), three = dir.file("three.pcd");
   ASSERT_TRUE(selseg_apps::writeLabeledCloud(one, cloud, labels, 1));
   ASSERT_TRUE(selseg_apps::writeLabeledCloud(three, cloud, labels, 3));
   EXPECT_TRUE(fileBytes(one) == fileBytes(three));
@@ -565,7 +574,7 @@ TEST(LabeledCloudWriter, PclReadsTheInputWithItsLabels)
   pcl::copyPointCloud(cloud, labeled);
   for (std::size_t i = 0; i < cloud.size(); ++i)
     labeled[i].label = labels[i];
-  const std::string pcl_file = (dir / "pcl.pcd").string();
+  const std::string pcl_file = dir.file("pcl.pcd");
   ASSERT_EQ(pcl::io::savePCDFileBinaryCompressed(pcl_file, labeled), 0);
   const auto header = [](const std::string& bytes) {
     return bytes.substr(0, bytes.find("DATA binary_compressed\n"));
@@ -576,9 +585,7 @@ TEST(LabeledCloudWriter, PclReadsTheInputWithItsLabels)
 
   // Labels that do not match the cloud: nothing is claimed written.
   labels.pop_back();
-  EXPECT_FALSE(
-      selseg_apps::writeLabeledCloud((dir / "bad.pcd").string(), cloud, labels));
-  fs::remove_all(dir);
+  EXPECT_FALSE(selseg_apps::writeLabeledCloud(dir.file("bad.pcd"), cloud, labels));
 }
 
 int
