@@ -205,6 +205,49 @@ TEST(SelectiveSegmentationUpdate, FinerScanOfAWindowChangesOnlyItsRegion)
   expectSameResult(seg, ref);
 }
 
+// New points inside the extent of the old ones leave the octree's box as it was: the
+// leaves away from them are kept (most of them), the others made again, and the result
+// is still extract()'s on the union. (New points beyond the old extent move the box,
+// which is fitted to the points, and every leaf is made again.)
+TEST(SelectiveSegmentationUpdate, LeavesAwayFromTheNewPointsAreKept)
+{
+  const auto coarse = toXYZ(*selseg_test::cubeScan(5000, 11));
+  const auto fine_all = toXYZ(*selseg_test::cubeScan(40000, 12));
+  Eigen::Array3f lo = Eigen::Array3f::Constant(1e9f), hi = -lo;
+  double t0 = 1e9, t1 = -1e9, p0 = 1e9, p1 = -1e9;
+  for (const auto& p : *coarse) {
+    lo = lo.min(p.getArray3fMap());
+    hi = hi.max(p.getArray3fMap());
+    t0 = std::min(t0, std::atan2(double(p.x), double(p.z)));
+    t1 = std::max(t1, std::atan2(double(p.x), double(p.z)));
+    p0 = std::min(p0, std::atan2(double(p.y), double(p.z)));
+    p1 = std::max(p1, std::atan2(double(p.y), double(p.z)));
+  }
+  const auto window_points = window(*fine_all,
+                                    t0 + 0.45 * (t1 - t0),
+                                    t0 + 0.65 * (t1 - t0),
+                                    p0 + 0.35 * (p1 - p0),
+                                    p0 + 0.55 * (p1 - p0));
+  Cloud fine;
+  for (const auto& p : *window_points)
+    if ((p.getArray3fMap() > lo + 0.02f).all() &&
+        (p.getArray3fMap() < hi - 0.02f).all())
+      fine.push_back(p);
+  ASSERT_GT(fine.size(), 500u);
+  Seg seg;
+  const double voxel = extractFirst(seg, coarse);
+  std::vector<pcl::PointIndices> clusters;
+  ASSERT_TRUE(seg.update(fine, clusters));
+  const auto& stats = seg.getUpdateStatistics();
+  EXPECT_TRUE(stats.incremental);
+  const std::size_t leaves = seg.getResult().leaves.size();
+  EXPECT_GT(stats.kept_leaves, leaves / 2) << leaves;
+  EXPECT_LT(stats.kept_leaves, leaves);
+  Seg ref;
+  reference(concat(*coarse, fine), voxel, ref);
+  expectSameResult(seg, ref);
+}
+
 TEST(SelectiveSegmentationUpdate, RepeatedUpdatesAndAnyOrderOfTheNewPoints)
 {
   auto scan = toXYZ(*selseg_test::cubeScan(8000, 21));
@@ -296,6 +339,25 @@ TEST(SelectiveSegmentationUpdate, ChangedParametersRunFromScratch)
   expectSameResult(seg, ref);
 }
 
+// The octree's thresholds changed since the result (the mesh is still updated in
+// place): no leaf of the previous result is kept, and the result is extract()'s.
+TEST(SelectiveSegmentationUpdate, ChangedSplitThresholdKeepsNoLeaf)
+{
+  const auto scan = toXYZ(*selseg_test::cubeScan(5000, 13));
+  const std::size_t n = scan->size();
+  Seg seg;
+  const double voxel = extractFirst(seg, slice(*scan, 0, n * 3 / 4));
+  std::vector<pcl::PointIndices> clusters;
+  seg.setMaxNormalStdDev(4.0 * M_PI / 180.0);
+  ASSERT_TRUE(seg.update(*slice(*scan, n * 3 / 4, n), clusters));
+  EXPECT_TRUE(seg.getUpdateStatistics().incremental);
+  EXPECT_EQ(seg.getUpdateStatistics().kept_leaves, 0u);
+  Seg ref;
+  ref.setMaxNormalStdDev(4.0 * M_PI / 180.0);
+  reference(scan, voxel, ref);
+  expectSameResult(seg, ref);
+}
+
 TEST(SelectiveSegmentationUpdate, NeedsAResultToUpdate)
 {
   Seg seg;
@@ -316,6 +378,8 @@ TEST(SelectiveSegmentationUpdate, NothingNewChangesNothing)
   EXPECT_TRUE(seg.getUpdateStatistics().incremental);
   EXPECT_EQ(seg.getUpdateStatistics().new_triangles, 0u);
   EXPECT_EQ(seg.getResult().labels, labels);
+  // Every leaf kept: no voxel changed.
+  EXPECT_EQ(seg.getUpdateStatistics().kept_leaves, seg.getResult().leaves.size());
 }
 
 TEST(SelectiveSegmentationUpdate, RingNormalsAndVertexMeanEdgeTestAreUpdatedInPlace)
@@ -335,6 +399,8 @@ TEST(SelectiveSegmentationUpdate, RingNormalsAndVertexMeanEdgeTestAreUpdatedInPl
     std::vector<pcl::PointIndices> clusters;
     ASSERT_TRUE(seg.update(*slice(*scan, split, scan->size()), clusters));
     EXPECT_TRUE(seg.getUpdateStatistics().incremental);
+    // k-ring normals change beyond the changed triangles: no leaf is kept.
+    EXPECT_EQ(seg.getUpdateStatistics().kept_leaves, 0u);
     Seg ref;
     ref.setParameters(params);
     reference(scan, voxel, ref);

@@ -96,6 +96,8 @@ BM_Update(benchmark::State& state)
   const auto& u = seg.getUpdateStatistics();
   state.counters["incremental"] = u.incremental;
   state.counters["replaced_triangles"] = static_cast<double>(u.replaced_triangles);
+  state.counters["kept_leaves"] = static_cast<double>(u.kept_leaves);
+  state.counters["leaves"] = static_cast<double>(seg.getResult().leaves.size());
   state.counters["points"] = static_cast<double>(s.all->size());
 }
 

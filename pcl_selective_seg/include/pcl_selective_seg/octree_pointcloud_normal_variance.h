@@ -148,6 +148,38 @@ public:
   /** \brief The leaves, in depth-first (Morton) order. */
   const std::vector<AdaptiveLeaf>& getAdaptiveLeaves() const { return leaves_; }
 
+  /** \brief What the next computeAdaptiveLeaves() of another tree may keep from this
+   * one (SelectiveSegmentation::update()): its leaves and what they were made with. */
+  struct PreviousLeaves {
+    std::vector<AdaptiveLeaf> leaves; ///< depth-first order
+    Eigen::Vector3d box_min = Eigen::Vector3d::Zero();
+    Eigen::Vector3d box_max = Eigen::Vector3d::Zero();
+    double resolution = 0.0;
+    unsigned int depth = 0;
+    double max_std_dev = 0.0;
+    std::size_t min_points_to_split = 0;
+    NormalSpreadFrame frame = NormalSpreadFrame::Sensor;
+    Eigen::Quaternionf orientation = Eigen::Quaternionf::Identity();
+    /** Positions whose voxel's points changed since: points added or removed, moved
+     * (the old and the new position), or whose normal or area changed. */
+    std::vector<Eigen::Vector3f> changed;
+  };
+
+  /** \brief This tree's leaves and what they were made with (PreviousLeaves::changed
+   * empty); no leaves before computeAdaptiveLeaves(). */
+  PreviousLeaves getPreviousLeaves() const;
+
+  /** \brief Lets the next computeAdaptiveLeaves() keep the leaves of \a previous under
+   * every node whose finest voxels hold no changed position, when the two trees have
+   * the same box, resolution and depth and the leaves were made with the same
+   * thresholds, frame and orientation. Such a node holds the same points, normals and
+   * areas in the same order, so its statistics, its splits and its leaves would be the
+   * same: the leaves are the ones computeAdaptiveLeaves() would make, bit for bit. */
+  void keepLeavesFrom(PreviousLeaves previous) { previous_ = std::move(previous); }
+
+  /** \brief Leaves the last computeAdaptiveLeaves() kept from keepLeavesFrom(). */
+  std::size_t getNumKeptLeaves() const { return num_kept_leaves_; }
+
   /** \brief Input point indices in depth-first order; each leaf owns a range. */
   const pcl::Indices& getOrderedIndices() const { return ordered_indices_; }
 
@@ -201,7 +233,10 @@ protected:
   NodeStatistics
   computeStatistics(std::size_t begin,
                     std::size_t end,
-                    double split_above = std::numeric_limits<double>::infinity()) const;
+                    double split_above = std::numeric_limits<double>::infinity());
+
+  /** \brief The sensor-frame angles of ordered point \a k from its normal. */
+  void sensorAngles(std::size_t k);
 
   /** \brief A node met while descending from the root: its finest voxels
    * [first_voxel, end_voxel) (a run of voxel_codes_) and its point range. */
@@ -216,6 +251,12 @@ protected:
 
   /** \brief A node kept as a leaf, with its statistics. */
   AdaptiveLeaf makeLeaf(const PendingNode& node, const NodeStatistics& s) const;
+
+  /** \brief Whether keepLeavesFrom()'s \a previous leaves were made by a tree like this
+   * one (box, resolution, depth, frame, orientation) with these thresholds. */
+  bool canKeepLeaves(const PreviousLeaves& previous,
+                     double max_std_dev,
+                     std::size_t min_points) const;
 
 private:
   /** The input normal of point \a i, from whichever form was given. */
@@ -258,6 +299,14 @@ private:
   detail::ScratchVector<double> ordered_phi_;
   detail::ScratchVector<double> ordered_weights_; ///< 1 / A_p (eq. 4)
   std::vector<AdaptiveLeaf> leaves_;
+  /** The thresholds the leaves were made with (getPreviousLeaves()). */
+  double leaves_max_std_dev_ = 0.0;
+  std::size_t leaves_min_points_ = 0;
+  PreviousLeaves previous_; ///< keepLeavesFrom(), used once
+  /** The sensor-frame angles are computed when a statistics pass reaches them (NaN
+   * until then), not all in advance: insertPoints() with leaves to keep. */
+  bool lazy_angles_ = false;
+  std::size_t num_kept_leaves_ = 0;
   unsigned int num_threads_ = defaultThreads();
 };
 

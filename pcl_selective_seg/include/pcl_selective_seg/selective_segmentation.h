@@ -34,6 +34,9 @@ struct UpdateStatistics {
   std::size_t replaced_triangles = 0; ///< old triangles the insertion replaced
   std::size_t new_triangles = 0;      ///< triangles not in the old mesh
   std::size_t changed_vertices = 0;   ///< vertices whose normal was recomputed
+  /** Octree leaves kept from the previous result: those under nodes whose finest
+   * voxels hold no new, moved or changed vertex (the rest are computed again). */
+  std::size_t kept_leaves = 0;
 };
 
 /** \brief Segmentation of a 3-D surface point cloud seen from one sensor viewpoint into
@@ -308,6 +311,9 @@ private:
   SelectiveSegmentationParameters mesh_params_;
   Eigen::Matrix4f mesh_pose_ = Eigen::Matrix4f::Zero();
   UpdateStatistics update_stats_;
+  /** update(): the previous octree's leaves and the positions changed since, for
+   * buildOctree() to keep what did not change; empty otherwise. */
+  typename Octree::PreviousLeaves previous_leaves_;
 };
 
 } // namespace selective_seg

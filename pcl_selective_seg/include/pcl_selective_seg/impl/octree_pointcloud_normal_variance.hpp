@@ -294,6 +294,9 @@ OctreePointCloudNormalVariance<PointT>::insertPoints(bool with_angles)
   voxel_indices_ = pcl::Indices();
   voxel_codes_.resize(num_voxels);
   resizeScratch(n);
+  // With leaves to keep (keepLeavesFrom()), the points under kept nodes never need
+  // their angles: each is computed when a statistics pass first reaches it.
+  lazy_angles_ = !previous_.leaves.empty();
   const Eigen::Matrix3d to_sensor =
       sensor_orientation_.toRotationMatrix().transpose().template cast<double>();
 #ifdef _OPENMP
@@ -371,16 +374,28 @@ OctreePointCloudNormalVariance<PointT>::computeNormalAngle(std::size_t k,
       -(to_sensor * inputNormal(i).template cast<double>()).normalized();
   ordered_normals_[k] = m;
   if (spread_frame_ == NormalSpreadFrame::Sensor) {
-    ordered_theta_[k] = std::atan2(m.x(), m.z());
-    ordered_phi_[k] = std::atan2(m.y(), m.z());
+    if (lazy_angles_) // computeStatistics() computes them when it reaches them
+      ordered_theta_[k] = ordered_phi_[k] = std::numeric_limits<double>::quiet_NaN();
+    else
+      sensorAngles(k);
   }
   ordered_weights_[k] = 1.0 / (*areas_)[i]; // eq. 4: weight 1 / A_p
 }
 
 template <typename PointT>
 void
+OctreePointCloudNormalVariance<PointT>::sensorAngles(std::size_t k)
+{
+  const Eigen::Vector3d& m = ordered_normals_[k];
+  ordered_theta_[k] = std::atan2(m.x(), m.z());
+  ordered_phi_[k] = std::atan2(m.y(), m.z());
+}
+
+template <typename PointT>
+void
 OctreePointCloudNormalVariance<PointT>::computeNormalAngles()
 {
+  lazy_angles_ = false;
   const std::size_t n = ordered_indices_.size();
   resizeScratch(n);
   const Eigen::Matrix3d to_sensor =
@@ -396,7 +411,7 @@ template <typename PointT>
 typename OctreePointCloudNormalVariance<PointT>::NodeStatistics
 OctreePointCloudNormalVariance<PointT>::computeStatistics(std::size_t begin,
                                                           std::size_t end,
-                                                          double split_above) const
+                                                          double split_above)
 {
   NodeStatistics s;
   for (std::size_t k = begin; k < end; ++k) {
@@ -417,6 +432,10 @@ OctreePointCloudNormalVariance<PointT>::computeStatistics(std::size_t begin,
   for (std::size_t k = begin; k < end;) {
     const std::size_t block_end = std::min(end, k + 256);
     if (sensor_frame) {
+      if (lazy_angles_) // the angles of the points this pass reaches, once
+        for (std::size_t j = k; j < block_end; ++j)
+          if (std::isnan(ordered_theta_[j]))
+            sensorAngles(j);
       for (; k < block_end; ++k) {
         const double w = ordered_weights_[k];
         const double dt = detail::wrapAngle(ordered_theta_[k] - theta_v);
@@ -478,6 +497,10 @@ OctreePointCloudNormalVariance<PointT>::computeAdaptiveLeaves(
     double max_std_dev, std::size_t min_points_to_split)
 {
   leaves_.clear();
+  // keepLeavesFrom() applies to this call only.
+  const PreviousLeaves previous = std::move(previous_);
+  previous_ = PreviousLeaves();
+  num_kept_leaves_ = 0;
   const bool angles_ready = angles_ready_;
   angles_ready_ = false;
   if (!angles_ready) {
@@ -538,6 +561,54 @@ OctreePointCloudNormalVariance<PointT>::computeAdaptiveLeaves(
       v = end;
     }
   };
+  // Leaves kept from a previous tree (keepLeavesFrom()): the first finest-voxel code of
+  // each previous leaf, and the codes of the finest voxels whose points changed.
+  const bool keep = canKeepLeaves(previous, max_std_dev, min_points_to_split) &&
+                    num_voxels > 0 && tree_depth <= 21; // 63-bit codes
+  std::vector<std::uint64_t> previous_first, changed_codes;
+  if (keep) {
+    previous_first.reserve(previous.leaves.size());
+    for (const AdaptiveLeaf& leaf : previous.leaves)
+      previous_first.push_back(detail::mortonCode(leaf.key)
+                               << (3 * (tree_depth - leaf.depth)));
+    for (const Eigen::Vector3f& position : previous.changed) {
+      PointT point;
+      point.x = position.x();
+      point.y = position.y();
+      point.z = position.z();
+      if (!position.allFinite() || !this->isPointWithinBoundingBox(point))
+        continue; // in neither tree: the box is the same
+      pcl::octree::OctreeKey key;
+      this->genOctreeKeyforPoint(point, key);
+      changed_codes.push_back(detail::mortonCode(key));
+    }
+    std::sort(changed_codes.begin(), changed_codes.end());
+  }
+  // The previous leaves [first, end) under a node whose finest voxels hold no changed
+  // position (then it holds the same points as before, in the same order), if the
+  // previous tree went down to it; (0, 0) otherwise.
+  const auto kept_leaves = [&](const PendingNode& node) {
+    const std::pair<std::size_t, std::size_t> none(0, 0);
+    if (!keep)
+      return none;
+    const unsigned shift = 3 * (tree_depth - node.depth);
+    const std::uint64_t lo = (voxel_codes_[node.first_voxel] >> shift) << shift;
+    const std::uint64_t hi = lo + (std::uint64_t{1} << shift);
+    const auto changed =
+        std::lower_bound(changed_codes.begin(), changed_codes.end(), lo);
+    if (changed != changed_codes.end() && *changed < hi)
+      return none;
+    const auto first =
+        std::lower_bound(previous_first.begin(), previous_first.end(), lo);
+    const auto end = std::lower_bound(first, previous_first.end(), hi);
+    const auto a = static_cast<std::size_t>(first - previous_first.begin());
+    const auto b = static_cast<std::size_t>(end - previous_first.begin());
+    // None: a previous leaf holds the node (the previous tree stopped above it).
+    if (a == b ||
+        previous.leaves[b - 1].end - previous.leaves[a].begin != node.end - node.begin)
+      return none;
+    return std::make_pair(a, b);
+  };
   std::vector<PendingNode> level(1), next;
   level[0].first_voxel = 0;
   level[0].end_voxel = num_voxels;
@@ -546,10 +617,12 @@ OctreePointCloudNormalVariance<PointT>::computeAdaptiveLeaves(
   // A leaf's place in leaves_; a branch's number of children, then its first child's
   // place in next.
   std::vector<std::size_t> slot;
+  std::vector<std::pair<std::size_t, std::size_t>> kept; // kept_leaves() of each node
   while (!level.empty()) {
     stats.resize(level.size());
     split.resize(level.size());
     slot.resize(level.size());
+    kept.resize(level.size());
     // One node (the root) is one thread's work. (Read by the pragmas only.)
     [[maybe_unused]] const bool parallel = level.size() > 1;
 #ifdef _OPENMP
@@ -558,6 +631,12 @@ OctreePointCloudNormalVariance<PointT>::computeAdaptiveLeaves(
     for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(level.size()); ++i) {
       PendingNode& node = level[i];
       std::tie(node.begin, node.end) = points_of(node);
+      kept[i] = kept_leaves(node);
+      if (kept[i].second > kept[i].first) {
+        split[i] = 0;
+        slot[i] = 0;
+        continue;
+      }
       // A node that may split needs its sigmas only until one exceeds the threshold.
       const bool can_split =
           node.depth < tree_depth && node.end - node.begin >= min_points;
@@ -581,8 +660,10 @@ OctreePointCloudNormalVariance<PointT>::computeAdaptiveLeaves(
         const std::size_t count = slot[i];
         slot[i] = num_children;
         num_children += count;
-      } else
-        slot[i] = first_new_leaf + num_new_leaves++;
+      } else {
+        slot[i] = first_new_leaf + num_new_leaves;
+        num_new_leaves += std::max<std::size_t>(1, kept[i].second - kept[i].first);
+      }
     }
     next.resize(num_children);
     // Grown by exactly this level's leaves: doubling would hold three times the leaves
@@ -596,7 +677,18 @@ OctreePointCloudNormalVariance<PointT>::computeAdaptiveLeaves(
     for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(level.size()); ++i) {
       const PendingNode& node = level[i];
       if (!split[i]) {
-        leaves_[slot[i]] = makeLeaf(node, stats[i]);
+        if (kept[i].second == kept[i].first) {
+          leaves_[slot[i]] = makeLeaf(node, stats[i]);
+          continue;
+        }
+        // The previous leaves, moved to the node's place in the new order.
+        const std::size_t previous_begin = previous.leaves[kept[i].first].begin;
+        for (std::size_t k = kept[i].first; k < kept[i].second; ++k) {
+          AdaptiveLeaf leaf = previous.leaves[k];
+          leaf.begin = node.begin + (leaf.begin - previous_begin);
+          leaf.end = node.begin + (leaf.end - previous_begin);
+          leaves_[slot[i] + (k - kept[i].first)] = leaf;
+        }
         continue;
       }
       std::size_t place = slot[i];
@@ -616,10 +708,53 @@ OctreePointCloudNormalVariance<PointT>::computeAdaptiveLeaves(
         leaves_.begin() + static_cast<std::ptrdiff_t>(first_new_leaf),
         leaves_.end(),
         [](const AdaptiveLeaf& a, const AdaptiveLeaf& b) { return a.begin < b.begin; });
+    for (const auto& k : kept)
+      num_kept_leaves_ += k.second - k.first;
     level.swap(next);
   }
+  leaves_max_std_dev_ = max_std_dev;
+  leaves_min_points_ = min_points_to_split;
+  lazy_angles_ = false;
   // The per-point scratch is not needed any more (the leaves hold their statistics).
   releaseScratch();
+}
+
+template <typename PointT>
+typename OctreePointCloudNormalVariance<PointT>::PreviousLeaves
+OctreePointCloudNormalVariance<PointT>::getPreviousLeaves() const
+{
+  PreviousLeaves p;
+  p.leaves = leaves_;
+  this->getBoundingBox(p.box_min.x(),
+                       p.box_min.y(),
+                       p.box_min.z(),
+                       p.box_max.x(),
+                       p.box_max.y(),
+                       p.box_max.z());
+  p.resolution = this->resolution_;
+  p.depth = this->octree_depth_;
+  p.max_std_dev = leaves_max_std_dev_;
+  p.min_points_to_split = leaves_min_points_;
+  p.frame = spread_frame_;
+  p.orientation = sensor_orientation_;
+  return p;
+}
+
+template <typename PointT>
+bool
+OctreePointCloudNormalVariance<PointT>::canKeepLeaves(const PreviousLeaves& previous,
+                                                      double max_std_dev,
+                                                      std::size_t min_points) const
+{
+  Eigen::Vector3d box_min, box_max;
+  this->getBoundingBox(
+      box_min.x(), box_min.y(), box_min.z(), box_max.x(), box_max.y(), box_max.z());
+  return !previous.leaves.empty() && previous.box_min == box_min &&
+         previous.box_max == box_max && previous.resolution == this->resolution_ &&
+         previous.depth == this->octree_depth_ && previous.max_std_dev == max_std_dev &&
+         previous.min_points_to_split == min_points &&
+         previous.frame == spread_frame_ &&
+         previous.orientation.coeffs() == sensor_orientation_.coeffs();
 }
 
 template <typename PointT>

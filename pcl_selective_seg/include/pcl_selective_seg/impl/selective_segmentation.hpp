@@ -279,8 +279,15 @@ SelectiveSegmentation<PointT>::buildOctree()
   octree_->setInputNormals(lent, vertex_areas_);
   octree_->setNumberOfThreads(static_cast<unsigned int>(params_.num_threads));
   octree_->setNormalSpreadFrame(params_.normal_spread_frame);
+  // update(): the previous leaves where nothing changed.
+  const bool keeping = !previous_leaves_.leaves.empty();
+  if (keeping)
+    octree_->keepLeavesFrom(std::move(previous_leaves_));
+  previous_leaves_ = typename Octree::PreviousLeaves();
   const bool inserted = octree_->addPointsAndComputeAdaptiveLeaves(
       params_.max_normal_std_dev, static_cast<std::size_t>(params_.min_points_to_split));
+  if (keeping)
+    update_stats_.kept_leaves = octree_->getNumKeptLeaves();
   octree_->setInputNormals(typename Octree::NormalVectorsConstPtr(), vertex_areas_);
   if (!inserted)
     return fail("extract", "no point with a normal to insert into the octree");
@@ -501,6 +508,7 @@ SelectiveSegmentation<PointT>::extract(std::vector<pcl::PointIndices>& clusters)
 {
   clusters.clear();
   clearOutputs();
+  previous_leaves_ = typename Octree::PreviousLeaves(); // from scratch
   pcl::StopWatch total;
   if (!initCompute()) {
     this->deinitCompute();

@@ -105,6 +105,23 @@ SelectiveSegmentation<PointT>::updateMesh(std::size_t first_new_point, bool& fai
   std::vector<double> old_areas;
   old_normals.swap(result_.mesh.normals);
   old_areas.swap(result_.mesh.areas);
+  // The octree's leaves, for buildOctree() to keep where nothing changed (k-ring
+  // normals change beyond the changed triangles' corners: not kept then), and the old
+  // positions of the moved vertices (their old voxels lost them).
+  previous_leaves_ = typename Octree::PreviousLeaves();
+  if (octree_ && params_.normal_rings == 1) {
+    previous_leaves_ = octree_->getPreviousLeaves();
+    if (!moved.empty()) {
+      std::vector<std::uint8_t> is_moved(
+          delaunay_.getTriangulation().vertex_positions.size(), 0);
+      for (const auto v : moved)
+        is_moved[v] = 1;
+      const auto& old_positions = *octree_->getInputCloud();
+      for (std::size_t v = 0; v < info.old_to_new_point.size(); ++v)
+        if (is_moved[info.old_to_new_point[v]])
+          previous_leaves_.changed.push_back(old_positions[v].getVector3fMap());
+    }
+  }
   update_stats_.incremental = true;
   update_stats_.new_vertices = info.inserted_points.size();
   update_stats_.moved_vertices = moved.size();
@@ -212,6 +229,11 @@ SelectiveSegmentation<PointT>::updateNormals(const DelaunayInsertion& info,
       touched[v] = 1;
   update_stats_.changed_vertices =
       static_cast<std::size_t>(std::count(touched.begin(), touched.end(), 1));
+  // Their voxels changed (the new vertices are corners of new triangles).
+  if (!previous_leaves_.leaves.empty())
+    for (std::size_t v = 0; v < num_vertices; ++v)
+      if (touched[v])
+        previous_leaves_.changed.push_back(tri.vertex_positions[v]);
   vertex_normals_.swap(vertex_normals);
   vertex_areas_ = vertex_areas;
 }
