@@ -145,6 +145,25 @@ concat(const Cloud& a, const Cloud& b)
   return out;
 }
 
+/** The points of \a fine in a window over a fifth of the width and height of
+ * \a coarse's view, off centre. */
+Cloud::Ptr
+offCentreWindow(const Cloud& coarse, const Cloud& fine)
+{
+  double t0 = 1e9, t1 = -1e9, p0 = 1e9, p1 = -1e9;
+  for (const auto& p : coarse) {
+    t0 = std::min(t0, std::atan2(double(p.x), double(p.z)));
+    t1 = std::max(t1, std::atan2(double(p.x), double(p.z)));
+    p0 = std::min(p0, std::atan2(double(p.y), double(p.z)));
+    p1 = std::max(p1, std::atan2(double(p.y), double(p.z)));
+  }
+  return window(fine,
+                t0 + 0.45 * (t1 - t0),
+                t0 + 0.65 * (t1 - t0),
+                p0 + 0.35 * (p1 - p0),
+                p0 + 0.55 * (p1 - p0));
+}
+
 } // namespace
 
 TEST(SelectiveSegmentationUpdate, RandomFifthOfTheScanEqualsExtractOnTheUnion)
@@ -173,20 +192,7 @@ TEST(SelectiveSegmentationUpdate, RandomFifthOfTheScanEqualsExtractOnTheUnion)
 TEST(SelectiveSegmentationUpdate, FinerScanOfAWindowChangesOnlyItsRegion)
 {
   const auto coarse = toXYZ(*selseg_test::cubeScan(5000, 11));
-  const auto fine_all = toXYZ(*selseg_test::cubeScan(40000, 12));
-  // A window over a fifth of the view's width and height, off centre.
-  double t0 = 1e9, t1 = -1e9, p0 = 1e9, p1 = -1e9;
-  for (const auto& p : *coarse) {
-    t0 = std::min(t0, std::atan2(double(p.x), double(p.z)));
-    t1 = std::max(t1, std::atan2(double(p.x), double(p.z)));
-    p0 = std::min(p0, std::atan2(double(p.y), double(p.z)));
-    p1 = std::max(p1, std::atan2(double(p.y), double(p.z)));
-  }
-  const auto fine = window(*fine_all,
-                           t0 + 0.45 * (t1 - t0),
-                           t0 + 0.65 * (t1 - t0),
-                           p0 + 0.35 * (p1 - p0),
-                           p0 + 0.55 * (p1 - p0));
+  const auto fine = offCentreWindow(*coarse, *toXYZ(*selseg_test::cubeScan(40000, 12)));
   ASSERT_GT(fine->size(), 500u);
   Seg seg;
   seg.setInputCloud(coarse);
@@ -212,24 +218,14 @@ TEST(SelectiveSegmentationUpdate, FinerScanOfAWindowChangesOnlyItsRegion)
 TEST(SelectiveSegmentationUpdate, LeavesAwayFromTheNewPointsAreKept)
 {
   const auto coarse = toXYZ(*selseg_test::cubeScan(5000, 11));
-  const auto fine_all = toXYZ(*selseg_test::cubeScan(40000, 12));
   Eigen::Array3f lo = Eigen::Array3f::Constant(1e9f), hi = -lo;
-  double t0 = 1e9, t1 = -1e9, p0 = 1e9, p1 = -1e9;
   for (const auto& p : *coarse) {
     lo = lo.min(p.getArray3fMap());
     hi = hi.max(p.getArray3fMap());
-    t0 = std::min(t0, std::atan2(double(p.x), double(p.z)));
-    t1 = std::max(t1, std::atan2(double(p.x), double(p.z)));
-    p0 = std::min(p0, std::atan2(double(p.y), double(p.z)));
-    p1 = std::max(p1, std::atan2(double(p.y), double(p.z)));
   }
-  const auto window_points = window(*fine_all,
-                                    t0 + 0.45 * (t1 - t0),
-                                    t0 + 0.65 * (t1 - t0),
-                                    p0 + 0.35 * (p1 - p0),
-                                    p0 + 0.55 * (p1 - p0));
   Cloud fine;
-  for (const auto& p : *window_points)
+  for (const auto& p :
+       *offCentreWindow(*coarse, *toXYZ(*selseg_test::cubeScan(40000, 12))))
     if ((p.getArray3fMap() > lo + 0.02f).all() &&
         (p.getArray3fMap() < hi - 0.02f).all())
       fine.push_back(p);
