@@ -223,9 +223,10 @@ TEST(SelectiveSegmentationUpdate, LeavesAwayFromTheNewPointsAreKept)
     lo = lo.min(p.getArray3fMap());
     hi = hi.max(p.getArray3fMap());
   }
+  const auto window_points =
+      offCentreWindow(*coarse, *toXYZ(*selseg_test::cubeScan(40000, 12)));
   Cloud fine;
-  for (const auto& p :
-       *offCentreWindow(*coarse, *toXYZ(*selseg_test::cubeScan(40000, 12))))
+  for (const auto& p : *window_points)
     if ((p.getArray3fMap() > lo + 0.02f).all() &&
         (p.getArray3fMap() < hi - 0.02f).all())
       fine.push_back(p);
