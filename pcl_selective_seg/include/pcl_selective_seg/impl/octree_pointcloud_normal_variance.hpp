@@ -603,8 +603,10 @@ OctreePointCloudNormalVariance<PointT>::computeAdaptiveLeaves(
     const auto end = std::lower_bound(first, previous_first.end(), hi);
     const auto a = static_cast<std::size_t>(first - previous_first.begin());
     const auto b = static_cast<std::size_t>(end - previous_first.begin());
-    // None: a previous leaf holds the node (the previous tree stopped above it).
-    if (a == b ||
+    // None when the previous tree stopped above the node: a previous leaf holds it,
+    // starting before it (then none starts inside) or with it (then that leaf is
+    // shallower than the node, even if all of its points lie in this node).
+    if (a == b || previous.leaves[a].depth < node.depth ||
         previous.leaves[b - 1].end - previous.leaves[a].begin != node.end - node.begin)
       return none;
     return std::make_pair(a, b);
