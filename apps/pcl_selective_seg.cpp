@@ -349,10 +349,8 @@ writeOutputs(const Options& opt,
                stats.already_fine,
                stats.over_budget);
   }
-  // The mesh writers use the segmentation's threads (-threads, 0 = automatic).
-  const int threads = opt.params.num_threads > 0
-                          ? opt.params.num_threads
-                          : static_cast<int>(pcl::selective_seg::defaultThreads());
+  // The writers use the segmentation's threads (-threads, 0 = automatic).
+  const int threads = pcl::selective_seg::detail::threadCount(opt.params.num_threads);
   const bool ok =
       write(opt.labels,
             [&](const std::string& f) {

@@ -139,13 +139,37 @@ writeRecords(std::ostream& out,
   for (std::size_t first = 0; first < count && out; first += per_block) {
     const auto n = static_cast<std::ptrdiff_t>(std::min(per_block, count - first));
 #ifdef _OPENMP
-#pragma omp parallel for num_threads(threads) schedule(static) if (n >= 16384)
+#pragma omp parallel for num_threads(std::max(1, threads))                             \
+    schedule(static) if (n >= 16384)
 #endif
     for (std::ptrdiff_t i = 0; i < n; ++i)
       fill(first + static_cast<std::size_t>(i), block.data() + i * size);
     out.write(block.data(), static_cast<std::streamsize>(n) * size);
   }
   static_cast<void>(threads); // without OpenMP
+}
+
+/** Items [0, count), each made by make(item, slot) on one of up to \a threads threads
+ * into its slot (0 .. threads - 1), a batch of one item per thread at a time; then
+ * write(slot) takes the batch's slots in item order and returns false to stop. Output
+ * in order, made in parallel, with memory for one item per thread. */
+template <typename Make, typename Write>
+void
+inOrderBatches(std::size_t count, int threads, const Make& make, const Write& write)
+{
+  const int width = std::max(1, threads);
+  const auto batch = static_cast<std::size_t>(width);
+  for (std::size_t first = 0; first < count; first += batch) {
+    const auto n = static_cast<std::ptrdiff_t>(std::min(batch, count - first));
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(width) schedule(static, 1) if (n > 1)
+#endif
+    for (std::ptrdiff_t k = 0; k < n; ++k)
+      make(first + static_cast<std::size_t>(k), static_cast<std::size_t>(k));
+    for (std::ptrdiff_t k = 0; k < n; ++k)
+      if (!write(static_cast<std::size_t>(k)))
+        return;
+  }
 }
 
 /** The colour of every label's interior triangles (segmentColor()), looked up instead
@@ -162,15 +186,14 @@ labelColors(const SegmentedMesh& mesh)
   return colors;
 }
 
-/** triangleColor() of triangle \a t, from the table of labelColors(). */
-const Rgb&
+/** triangleColor() of triangle \a t, an interior one's from the table of
+ * labelColors(). */
+Rgb
 faceColor(const SegmentedMesh& mesh, const std::vector<Rgb>& colors, std::size_t t)
 {
-  static const Rgb kWhite =
-      triangleColor(0, pcl::selective_seg::TriangleClass::InvalidEdge);
   return mesh.classes[t] == pcl::selective_seg::TriangleClass::Interior
              ? colors[mesh.labels[t]]
-             : kWhite;
+             : triangleColor(mesh.labels[t], mesh.classes[t]);
 }
 
 std::string
@@ -281,12 +304,12 @@ writeLabeledCloud(const std::string& path,
   // chunks do not depend on the thread count, so neither do the bytes.
   constexpr std::size_t kChunk = std::size_t{1} << 20;
   const std::size_t num_chunks = (data_size + kChunk - 1) / kChunk;
-  const auto batch = static_cast<std::size_t>(std::max(1, threads));
+  const auto slots = static_cast<std::size_t>(std::max(1, threads));
   const std::size_t chunk_bytes = std::min(kChunk, data_size);
-  std::vector<std::vector<char>> in(batch, std::vector<char>(chunk_bytes));
+  std::vector<std::vector<char>> in(slots, std::vector<char>(chunk_bytes));
   std::vector<std::vector<char>> packed(
-      batch, std::vector<char>(chunk_bytes + chunk_bytes / 2 + 16));
-  std::vector<unsigned int> packed_size(batch);
+      slots, std::vector<char>(chunk_bytes + chunk_bytes / 2 + 16));
+  std::vector<unsigned int> packed_size(slots);
   const auto fill = [&](std::size_t chunk, char* out) {
     // Byte offsets are multiples of 4: whole values.
     const std::size_t first = chunk * kChunk / 4;
@@ -312,25 +335,23 @@ writeLabeledCloud(const std::string& path,
   out.write(reinterpret_cast<const char*>(&compressed), 4);
   out.write(reinterpret_cast<const char*>(&uncompressed), 4);
   bool ok = true;
-  for (std::size_t first = 0; first < num_chunks && ok && out; first += batch) {
-    const auto count = static_cast<std::ptrdiff_t>(std::min(batch, num_chunks - first));
-#ifdef _OPENMP
-#pragma omp parallel for num_threads(threads) schedule(static, 1) if (count > 1)
-#endif
-    for (std::ptrdiff_t k = 0; k < count; ++k) {
-      const std::size_t length = fill(first + k, in[k].data());
-      packed_size[k] = pcl::lzfCompress(in[k].data(),
-                                        static_cast<unsigned int>(length),
-                                        packed[k].data(),
-                                        static_cast<unsigned int>(packed[k].size()));
-    }
-    for (std::ptrdiff_t k = 0; k < count && ok; ++k) {
-      ok = packed_size[k] > 0 && std::uint64_t{compressed} + packed_size[k] <=
-                                     std::numeric_limits<std::uint32_t>::max();
-      compressed += packed_size[k];
-      out.write(packed[k].data(), packed_size[k]);
-    }
-  }
+  inOrderBatches(
+      num_chunks,
+      threads,
+      [&](std::size_t chunk, std::size_t k) {
+        const std::size_t length = fill(chunk, in[k].data());
+        packed_size[k] = pcl::lzfCompress(in[k].data(),
+                                          static_cast<unsigned int>(length),
+                                          packed[k].data(),
+                                          static_cast<unsigned int>(packed[k].size()));
+      },
+      [&](std::size_t k) {
+        ok = packed_size[k] > 0 && std::uint64_t{compressed} + packed_size[k] <=
+                                       std::numeric_limits<std::uint32_t>::max();
+        compressed += packed_size[k];
+        out.write(packed[k].data(), packed_size[k]);
+        return ok && static_cast<bool>(out);
+      });
   out.seekp(sizes_at);
   out.write(reinterpret_cast<const char*>(&compressed), 4);
   out.close();
@@ -477,41 +498,35 @@ writeSummaryJson(const std::string& path,
   // prints at precision 9), a block per thread at a time, written in order.
   const std::size_t num_segments = r.segments.size();
   constexpr std::size_t kPerBlock = 4096;
-  const std::size_t num_blocks = (num_segments + kPerBlock - 1) / kPerBlock;
-  const auto batch = static_cast<std::size_t>(std::max(1, threads));
-  std::vector<std::string> blocks(batch);
-  for (std::size_t first_block = 0; first_block < num_blocks; first_block += batch) {
-    const auto count =
-        static_cast<std::ptrdiff_t>(std::min(batch, num_blocks - first_block));
-#ifdef _OPENMP
-#pragma omp parallel for num_threads(threads) schedule(static, 1) if (count > 1)
-#endif
-    for (std::ptrdiff_t k = 0; k < count; ++k) {
-      std::string& text = blocks[static_cast<std::size_t>(k)];
-      text.clear();
-      const std::size_t first = (first_block + static_cast<std::size_t>(k)) * kPerBlock;
-      for (std::size_t s = first; s < std::min(num_segments, first + kPerBlock); ++s) {
-        const auto& seg = r.segments[s];
-        char line[320];
-        const int length = std::snprintf(
-            line,
-            sizeof(line),
-            "%s{\"label\": %u, \"points\": %zu, \"leaves\": %zu, \"area_m2\": %.9g, "
-            "\"normal\": [%.9g, %.9g, %.9g]}",
-            s ? ",\n    " : "\n    ",
-            static_cast<unsigned>(seg.label),
-            seg.num_points,
-            seg.num_leaves,
-            seg.area,
-            static_cast<double>(seg.normal.x()),
-            static_cast<double>(seg.normal.y()),
-            static_cast<double>(seg.normal.z()));
-        text.append(line, static_cast<std::size_t>(std::max(0, length)));
-      }
-    }
-    for (std::ptrdiff_t k = 0; k < count; ++k)
-      out << blocks[static_cast<std::size_t>(k)];
-  }
+  std::vector<std::string> blocks(static_cast<std::size_t>(std::max(1, threads)));
+  inOrderBatches(
+      (num_segments + kPerBlock - 1) / kPerBlock,
+      threads,
+      [&](std::size_t block, std::size_t k) {
+        std::string& text = blocks[k];
+        text.clear();
+        const std::size_t first = block * kPerBlock;
+        for (std::size_t s = first; s < std::min(num_segments, first + kPerBlock);
+             ++s) {
+          const auto& seg = r.segments[s];
+          char line[320];
+          const int length = std::snprintf(
+              line,
+              sizeof(line),
+              "%s{\"label\": %u, \"points\": %zu, \"leaves\": %zu, \"area_m2\": %.9g, "
+              "\"normal\": [%.9g, %.9g, %.9g]}",
+              s ? ",\n    " : "\n    ",
+              static_cast<unsigned>(seg.label),
+              seg.num_points,
+              seg.num_leaves,
+              seg.area,
+              static_cast<double>(seg.normal.x()),
+              static_cast<double>(seg.normal.y()),
+              static_cast<double>(seg.normal.z()));
+          text.append(line, static_cast<std::size_t>(std::max(0, length)));
+        }
+      },
+      [&](std::size_t k) { return static_cast<bool>(out << blocks[k]); });
   out << "\n  ]\n}\n";
   out.close();
   return static_cast<bool>(out);
