@@ -148,10 +148,10 @@ public:
   /** \brief The leaves, in depth-first (Morton) order. */
   const std::vector<AdaptiveLeaf>& getAdaptiveLeaves() const { return leaves_; }
 
-  /** \brief What the next computeAdaptiveLeaves() of another tree may keep from this
-   * one (SelectiveSegmentation::update()): its leaves and what they were made with. */
-  struct PreviousLeaves {
-    std::vector<AdaptiveLeaf> leaves; ///< depth-first order
+  /** \brief What a tree's leaves depend on besides its points: the box, finest
+   * voxel and depth, the thresholds, the frame of eq. 5's angles and the sensor
+   * orientation. */
+  struct LeafSettings {
     Eigen::Vector3d box_min = Eigen::Vector3d::Zero();
     Eigen::Vector3d box_max = Eigen::Vector3d::Zero();
     double resolution = 0.0;
@@ -160,6 +160,22 @@ public:
     std::size_t min_points_to_split = 0;
     NormalSpreadFrame frame = NormalSpreadFrame::Sensor;
     Eigen::Quaternionf orientation = Eigen::Quaternionf::Identity();
+
+    bool operator==(const LeafSettings& other) const
+    {
+      return box_min == other.box_min && box_max == other.box_max &&
+             resolution == other.resolution && depth == other.depth &&
+             max_std_dev == other.max_std_dev &&
+             min_points_to_split == other.min_points_to_split && frame == other.frame &&
+             orientation.coeffs() == other.orientation.coeffs();
+    }
+  };
+
+  /** \brief What the next computeAdaptiveLeaves() of another tree may keep from this
+   * one (SelectiveSegmentation::update()): its leaves and what they were made with. */
+  struct PreviousLeaves {
+    std::vector<AdaptiveLeaf> leaves; ///< depth-first order
+    LeafSettings settings;
     /** Positions whose voxel's points changed since: points added or removed, moved
      * (the old and the new position), or whose normal or area changed. */
     std::vector<Eigen::Vector3f> changed;
@@ -252,11 +268,8 @@ protected:
   /** \brief A node kept as a leaf, with its statistics. */
   AdaptiveLeaf makeLeaf(const PendingNode& node, const NodeStatistics& s) const;
 
-  /** \brief Whether keepLeavesFrom()'s \a previous leaves were made by a tree like this
-   * one (box, resolution, depth, frame, orientation) with these thresholds. */
-  bool canKeepLeaves(const PreviousLeaves& previous,
-                     double max_std_dev,
-                     std::size_t min_points) const;
+  /** \brief This tree's LeafSettings with these thresholds. */
+  LeafSettings leafSettings(double max_std_dev, std::size_t min_points_to_split) const;
 
 private:
   /** The input normal of point \a i, from whichever form was given. */

@@ -563,8 +563,10 @@ OctreePointCloudNormalVariance<PointT>::computeAdaptiveLeaves(
   };
   // Leaves kept from a previous tree (keepLeavesFrom()): the first finest-voxel code of
   // each previous leaf, and the codes of the finest voxels whose points changed.
-  const bool keep = canKeepLeaves(previous, max_std_dev, min_points_to_split) &&
-                    num_voxels > 0 && tree_depth <= 21; // 63-bit codes
+  const bool keep =
+      !previous.leaves.empty() &&
+      previous.settings == leafSettings(max_std_dev, min_points_to_split) &&
+      num_voxels > 0 && tree_depth <= 21; // 63-bit codes
   std::vector<std::uint64_t> previous_first, changed_codes;
   if (keep) {
     previous_first.reserve(previous.leaves.size());
@@ -665,6 +667,7 @@ OctreePointCloudNormalVariance<PointT>::computeAdaptiveLeaves(
       } else {
         slot[i] = first_new_leaf + num_new_leaves;
         num_new_leaves += std::max<std::size_t>(1, kept[i].second - kept[i].first);
+        num_kept_leaves_ += kept[i].second - kept[i].first;
       }
     }
     next.resize(num_children);
@@ -710,8 +713,6 @@ OctreePointCloudNormalVariance<PointT>::computeAdaptiveLeaves(
         leaves_.begin() + static_cast<std::ptrdiff_t>(first_new_leaf),
         leaves_.end(),
         [](const AdaptiveLeaf& a, const AdaptiveLeaf& b) { return a.begin < b.begin; });
-    for (const auto& k : kept)
-      num_kept_leaves_ += k.second - k.first;
     level.swap(next);
   }
   leaves_max_std_dev_ = max_std_dev;
@@ -727,36 +728,29 @@ OctreePointCloudNormalVariance<PointT>::getPreviousLeaves() const
 {
   PreviousLeaves p;
   p.leaves = leaves_;
-  this->getBoundingBox(p.box_min.x(),
-                       p.box_min.y(),
-                       p.box_min.z(),
-                       p.box_max.x(),
-                       p.box_max.y(),
-                       p.box_max.z());
-  p.resolution = this->resolution_;
-  p.depth = this->octree_depth_;
-  p.max_std_dev = leaves_max_std_dev_;
-  p.min_points_to_split = leaves_min_points_;
-  p.frame = spread_frame_;
-  p.orientation = sensor_orientation_;
+  p.settings = leafSettings(leaves_max_std_dev_, leaves_min_points_);
   return p;
 }
 
 template <typename PointT>
-bool
-OctreePointCloudNormalVariance<PointT>::canKeepLeaves(const PreviousLeaves& previous,
-                                                      double max_std_dev,
-                                                      std::size_t min_points) const
+typename OctreePointCloudNormalVariance<PointT>::LeafSettings
+OctreePointCloudNormalVariance<PointT>::leafSettings(
+    double max_std_dev, std::size_t min_points_to_split) const
 {
-  Eigen::Vector3d box_min, box_max;
-  this->getBoundingBox(
-      box_min.x(), box_min.y(), box_min.z(), box_max.x(), box_max.y(), box_max.z());
-  return !previous.leaves.empty() && previous.box_min == box_min &&
-         previous.box_max == box_max && previous.resolution == this->resolution_ &&
-         previous.depth == this->octree_depth_ && previous.max_std_dev == max_std_dev &&
-         previous.min_points_to_split == min_points &&
-         previous.frame == spread_frame_ &&
-         previous.orientation.coeffs() == sensor_orientation_.coeffs();
+  LeafSettings s;
+  this->getBoundingBox(s.box_min.x(),
+                       s.box_min.y(),
+                       s.box_min.z(),
+                       s.box_max.x(),
+                       s.box_max.y(),
+                       s.box_max.z());
+  s.resolution = this->resolution_;
+  s.depth = this->octree_depth_;
+  s.max_std_dev = max_std_dev;
+  s.min_points_to_split = min_points_to_split;
+  s.frame = spread_frame_;
+  s.orientation = sensor_orientation_;
+  return s;
 }
 
 template <typename PointT>

@@ -223,17 +223,19 @@ SelectiveSegmentation<PointT>::updateNormals(const DelaunayInsertion& info,
                                  params_.normal_rings,
                                  changed,
                                  vertex_normals);
+  // The vertices of the changed triangles; their voxels changed for the octree (the new
+  // vertices are corners of new triangles).
+  const bool note_changes = !previous_leaves_.leaves.empty();
   std::vector<std::uint8_t> touched(num_vertices, 0);
+  update_stats_.changed_vertices = 0;
   for (const auto t : changed)
     for (const auto v : tri.triangles[t])
-      touched[v] = 1;
-  update_stats_.changed_vertices =
-      static_cast<std::size_t>(std::count(touched.begin(), touched.end(), 1));
-  // Their voxels changed (the new vertices are corners of new triangles).
-  if (!previous_leaves_.leaves.empty())
-    for (std::size_t v = 0; v < num_vertices; ++v)
-      if (touched[v])
-        previous_leaves_.changed.push_back(tri.vertex_positions[v]);
+      if (!touched[v]) {
+        touched[v] = 1;
+        ++update_stats_.changed_vertices;
+        if (note_changes)
+          previous_leaves_.changed.push_back(tri.vertex_positions[v]);
+      }
   vertex_normals_.swap(vertex_normals);
   vertex_areas_ = vertex_areas;
 }
