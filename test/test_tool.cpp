@@ -21,6 +21,7 @@
 #include <iterator>
 #include <limits>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <string>
 
@@ -61,6 +62,31 @@ fileBytes(const std::string& path)
   return std::string((std::istreambuf_iterator<char>(in)), {});
 }
 
+/** A fresh folder under the temporary directory, removed with everything in it when it
+ * goes out of scope (also when an assertion ends the test). */
+class ScratchDir {
+public:
+  explicit ScratchDir(const std::string& name)
+      : path_(fs::temp_directory_path() / (name + "_" + std::to_string(::getpid())))
+  {
+    fs::remove_all(path_);
+    fs::create_directories(path_);
+  }
+  ~ScratchDir()
+  {
+    std::error_code ignored;
+    fs::remove_all(path_, ignored);
+  }
+  ScratchDir(const ScratchDir&) = delete;
+  ScratchDir& operator=(const ScratchDir&) = delete;
+  const fs::path& path() const { return path_; }
+  /** The path of \a name in it. */
+  std::string file(const std::string& name) const { return (path_ / name).string(); }
+
+private:
+  fs::path path_;
+};
+
 class Tool : public ::testing::Test {
 protected:
   void
@@ -68,29 +94,17 @@ protected:
   {
     if (tool.empty() || !fs::exists(tool) || !fs::exists(scan))
       GTEST_SKIP() << "tool or scan missing";
-    dir = fs::temp_directory_path() /
-          ("selseg_tool_" + std::string(
-                                ::testing::UnitTest::GetInstance()->current_test_info()->name()));
-    fs::remove_all(dir);
-    fs::create_directories(dir);
+    dir.emplace(std::string("selseg_tool_") +
+                ::testing::UnitTest::GetInstance()->current_test_info()->name());
   }
-  void
-  TearDown() override
-  {
-    fs::remove_all(dir);
-  }
-  std::string
-  out(const std::string& name) const
-  {
-    return (dir / name).string();
-  }
+  std::string out(const std::string& name) const { return dir->file(name); }
   std::size_t
   files() const
   {
     return static_cast<std::size_t>(
-        std::distance(fs::directory_iterator(dir), fs::directory_iterator()));
+        std::distance(fs::directory_iterator(dir->path()), fs::directory_iterator()));
   }
-  fs::path dir;
+  std::optional<ScratchDir> dir;
 };
 
 /** The element count a PLY header declares. */
@@ -315,30 +329,6 @@ namespace {
 
 using pcl::selective_seg::SegmentedMesh;
 using pcl::selective_seg::TriangleClass;
-
-/** A fresh folder under the temporary directory, removed with everything in it when it
- * goes out of scope (also when an assertion ends the test). */
-class ScratchDir {
-public:
-  explicit ScratchDir(const std::string& name)
-      : path_(fs::temp_directory_path() / (name + "_" + std::to_string(::getpid())))
-  {
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~ScratchDir()
-  {
-    std::error_code ignored;
-    fs::remove_all(path_, ignored);
-  }
-  ScratchDir(const ScratchDir&) = delete;
-  ScratchDir& operator=(const ScratchDir&) = delete;
-  /** The path of \a name in it. */
-  std::string file(const std::string& name) const { return (path_ / name).string(); }
-
-private:
-  fs::path path_;
-};
 
 /** Bytes of a 32-bit pattern, least significant first or last. */
 std::string
