@@ -7,6 +7,7 @@
 #define PCL_NO_PRECOMPILE
 #include "outputs.h"
 
+#include <pcl/console/print.h>
 #include <pcl/io/lzf.h>
 #include <pcl/io/pcd_io.h>
 #include <pcl/point_types.h>
@@ -280,8 +281,16 @@ writeLabeledCloud(const std::string& path,
 {
   const std::size_t n = cloud.size();
   const std::size_t data_size = 16 * n; // the planes x, y, z, label
-  if (labels.size() != n || data_size > std::numeric_limits<std::uint32_t>::max())
+  if (labels.size() != n)
     return false;
+  if (data_size > std::numeric_limits<std::uint32_t>::max()) {
+    PCL_ERROR("The labeled cloud has %zu points: a binary_compressed PCD holds at most "
+              "%zu (its data sizes are 32-bit). Write the mesh instead (-mesh_ply), or "
+              "segment a part of the cloud.\n",
+              n,
+              static_cast<std::size_t>(std::numeric_limits<std::uint32_t>::max() / 16));
+    return false;
+  }
   // PCL's header for x y z label with the input's width, height and viewpoint, made for
   // a cloud of that shape without points; only its POINTS line depends on them.
   pcl::PointCloud<pcl::PointXYZL> shape;
