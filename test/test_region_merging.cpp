@@ -21,7 +21,9 @@
 using pcl::selective_seg::classifyTriangles;
 using pcl::selective_seg::Incidence;
 using pcl::selective_seg::MergeInput;
+using pcl::selective_seg::MergeReplay;
 using pcl::selective_seg::mergeSeedSegments;
+using pcl::selective_seg::seedOrder;
 using pcl::selective_seg::Triangle;
 using pcl::selective_seg::TriangleClass;
 using pcl::selective_seg::Vector3fVector;
@@ -472,6 +474,137 @@ TEST(MergeSeedSegments, LeavesInPlaceOfArrays)
     mergeSeedSegments(in_place, b.leaf_segment, b.segment_normals);
     EXPECT_EQ(a.leaf_segment, b.leaf_segment);
     EXPECT_EQ(a.segment_normals, b.segment_normals);
+  }
+}
+
+/** A merge's output with its seeds, and the replay of it for a later merge in which the
+ * leaves flagged in \a changed are changed (their segments cannot be taken over). */
+struct Replayable {
+  Merged merged;
+  std::vector<pcl::index_t> seeds;
+  std::vector<pcl::index_t> leaf_segment, segment_seed;
+  MergeReplay replay;
+
+  explicit Replayable(const MergeInput& in)
+  {
+    mergeSeedSegments(in, merged.leaf_segment, merged.segment_normals);
+    // Segment s grew from its first leaf in the seed order.
+    seeds.assign(merged.segment_normals.size(), -1);
+    for (const auto l : seedOrder(*in.vertex_leaf, in.leaf_normals->size()))
+      if (seeds[merged.leaf_segment[l]] < 0)
+        seeds[merged.leaf_segment[l]] = l;
+  }
+
+  MergeReplay* forChanged(const std::vector<bool>& changed)
+  {
+    leaf_segment = merged.leaf_segment;
+    segment_seed = seeds;
+    for (std::size_t l = 0; l < changed.size(); ++l)
+      if (changed[l]) {
+        segment_seed[leaf_segment[l]] = -1;
+        leaf_segment[l] = -1;
+      }
+    replay = MergeReplay();
+    replay.leaf_segment = &leaf_segment;
+    replay.segment_seed = &segment_seed;
+    replay.segment_normals = &merged.segment_normals;
+    return &replay;
+  }
+};
+
+// The seed order: most vertices first, ties by leaf index; segments are numbered in
+// the order their first leaf in it comes.
+TEST(MergeSeedSegments, SeedOrder)
+{
+  const Strip strip({0, 0, 1, 1, 2, 2, 2, 2}, {0.0, 20.0, 40.0}, {1.0, 1.0, 1.0});
+  EXPECT_EQ(seedOrder(strip.vertex_leaf, 3), (Segments{2, 0, 1}));
+  EXPECT_EQ(seedOrder({-1, 1, 0, 2, 1, -1}, 4), (Segments{1, 0, 2, 3}));
+  const Replayable r(strip.input());
+  EXPECT_EQ(r.merged.leaf_segment, (Segments{1, 0, 0})); // C took B; then A
+  EXPECT_EQ(r.seeds, (Segments{2, 0}));
+  const NoisyGrid grid(70, 2, true, 3);
+  Merged m = merge(grid.input(2));
+  pcl::index_t next = 0;
+  for (const auto l : seedOrder(grid.vertex_leaf, grid.leaf_normals.size())) {
+    ASSERT_LE(m.leaf_segment[l], next);
+    next = std::max(next, m.leaf_segment[l] + 1);
+  }
+  EXPECT_EQ(next, static_cast<pcl::index_t>(m.segment_normals.size()));
+}
+
+// A previous segment next to a changed leaf that is free at its turn is grown again:
+// here the changed leaf now joins it. Taken over, it would have stayed alone.
+TEST(MergeSeedSegments, ReplayGrowsAgainNextToAFreeChangedLeaf)
+{
+  // Before: A = 0 degrees (large), B = 40: two segments.
+  Replayable before(Strip({0, 0, 0, 0, 1, 1}, {0.0, 40.0}, {1.0, 1.0}).input());
+  ASSERT_EQ(before.merged.leaf_segment, (Segments{0, 1}));
+  // Now B is at 10 degrees: A's growth takes it.
+  const Strip now({0, 0, 0, 0, 1, 1}, {0.0, 10.0}, {1.0, 1.0});
+  for (const int threads : {1, 2}) {
+    MergeInput in = now.input(threads);
+    in.replay = before.forChanged({false, true});
+    Merged m;
+    mergeSeedSegments(in, m.leaf_segment, m.segment_normals);
+    EXPECT_EQ(m.leaf_segment, (Segments{0, 0}));
+    EXPECT_EQ(m.segment_normals, merge(now.input()).segment_normals);
+    EXPECT_EQ(in.replay->num_replayed, 0u);
+  }
+  // Unchanged, A is taken over, and B with it.
+  const Strip same({0, 0, 0, 0, 1, 1}, {0.0, 40.0}, {1.0, 1.0});
+  MergeInput in = same.input();
+  in.replay = before.forChanged({false, false});
+  Merged m;
+  mergeSeedSegments(in, m.leaf_segment, m.segment_normals);
+  EXPECT_EQ(m.leaf_segment, before.merged.leaf_segment);
+  EXPECT_EQ(m.segment_normals, before.merged.segment_normals);
+  EXPECT_EQ(in.replay->num_replayed, 2u);
+}
+
+// Taking segments over gives the merge's own result, bit for bit, for any thread count:
+// with nothing changed (every segment taken over), and with a random tenth of the
+// leaves changed (a new normal; their segments grow again, and so do the unchanged
+// segments whose neighbourhood is not in the state it was).
+TEST(MergeSeedSegments, ReplayGivesTheMergesOwnResult)
+{
+  for (const auto& [n, shuffle] :
+       std::vector<std::pair<int, bool>>{{70, false}, {150, true}}) {
+    SCOPED_TRACE(::testing::Message() << n << " " << shuffle);
+    const NoisyGrid grid(n, 2, shuffle, static_cast<unsigned>(n));
+    Replayable before(grid.input(1));
+    const std::size_t num_segments = before.merged.segment_normals.size();
+    ASSERT_GT(num_segments, 20u);
+    NoisyGrid changed_grid = grid;
+    std::vector<bool> changed(grid.leaf_normals.size(), false);
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    for (std::size_t l = 0; l < changed.size(); ++l)
+      if (unit(rng) < 0.1) {
+        changed[l] = true;
+        changed_grid.leaf_normals[l] =
+            Eigen::Vector3f(static_cast<float>(unit(rng) - 0.5), 0.2f, -1.0f)
+                .normalized();
+      }
+    for (const int threads : {1, 2, 3}) {
+      SCOPED_TRACE(threads);
+      MergeInput in = grid.input(threads);
+      in.replay = before.forChanged(std::vector<bool>(changed.size(), false));
+      Merged same;
+      mergeSeedSegments(in, same.leaf_segment, same.segment_normals);
+      EXPECT_EQ(same.leaf_segment, before.merged.leaf_segment);
+      EXPECT_EQ(same.segment_normals, before.merged.segment_normals);
+      EXPECT_EQ(in.replay->num_replayed, num_segments);
+
+      const Merged expected = merge(changed_grid.input(threads));
+      in = changed_grid.input(threads);
+      in.replay = before.forChanged(changed);
+      Merged m;
+      mergeSeedSegments(in, m.leaf_segment, m.segment_normals);
+      EXPECT_EQ(m.leaf_segment, expected.leaf_segment);
+      EXPECT_EQ(m.segment_normals, expected.segment_normals);
+      EXPECT_GT(in.replay->num_replayed, 0u);
+      EXPECT_LT(in.replay->num_replayed, expected.segment_normals.size());
+    }
   }
 }
 

@@ -164,6 +164,26 @@ offCentreWindow(const Cloud& coarse, const Cloud& fine)
                 p0 + 0.55 * (p1 - p0));
 }
 
+/** The points of a finer cube scan in an off-centre window, strictly inside the box of
+ * \a coarse: the octree keeps its box, so leaves away from them can be kept. */
+Cloud
+interiorWindow(const Cloud& coarse)
+{
+  Eigen::Array3f lo = Eigen::Array3f::Constant(1e9f), hi = -lo;
+  for (const auto& p : coarse) {
+    lo = lo.min(p.getArray3fMap());
+    hi = hi.max(p.getArray3fMap());
+  }
+  const auto window_points =
+      offCentreWindow(coarse, *toXYZ(*selseg_test::cubeScan(40000, 12)));
+  Cloud fine;
+  for (const auto& p : *window_points)
+    if ((p.getArray3fMap() > lo + 0.02f).all() &&
+        (p.getArray3fMap() < hi - 0.02f).all())
+      fine.push_back(p);
+  return fine;
+}
+
 } // namespace
 
 TEST(SelectiveSegmentationUpdate, RandomFifthOfTheScanEqualsExtractOnTheUnion)
@@ -218,18 +238,7 @@ TEST(SelectiveSegmentationUpdate, FinerScanOfAWindowChangesOnlyItsRegion)
 TEST(SelectiveSegmentationUpdate, LeavesAwayFromTheNewPointsAreKept)
 {
   const auto coarse = toXYZ(*selseg_test::cubeScan(5000, 11));
-  Eigen::Array3f lo = Eigen::Array3f::Constant(1e9f), hi = -lo;
-  for (const auto& p : *coarse) {
-    lo = lo.min(p.getArray3fMap());
-    hi = hi.max(p.getArray3fMap());
-  }
-  const auto window_points =
-      offCentreWindow(*coarse, *toXYZ(*selseg_test::cubeScan(40000, 12)));
-  Cloud fine;
-  for (const auto& p : *window_points)
-    if ((p.getArray3fMap() > lo + 0.02f).all() &&
-        (p.getArray3fMap() < hi - 0.02f).all())
-      fine.push_back(p);
+  const Cloud fine = interiorWindow(*coarse);
   ASSERT_GT(fine.size(), 500u);
   Seg seg;
   const double voxel = extractFirst(seg, coarse);
@@ -240,9 +249,42 @@ TEST(SelectiveSegmentationUpdate, LeavesAwayFromTheNewPointsAreKept)
   const std::size_t leaves = seg.getResult().leaves.size();
   EXPECT_GT(stats.kept_leaves, leaves / 2) << leaves;
   EXPECT_LT(stats.kept_leaves, leaves);
+  // Most segments away from the window are taken over from the previous merge.
+  const std::size_t segments = seg.getResult().segments.size();
+  EXPECT_GT(stats.replayed_segments, segments / 2) << segments;
+  EXPECT_LT(stats.replayed_segments, segments);
   Seg ref;
   reference(concat(*coarse, fine), voxel, ref);
   expectSameResult(seg, ref);
+}
+
+// Segments are taken over only from a merge with the same parameters and the facet
+// normals in the edge test: a changed merge angle, or vertex-mean edge normals (which
+// change with the neighbours' vertex normals), keep the leaves but grow every segment.
+TEST(SelectiveSegmentationUpdate, ChangedMergeParametersReplayNoSegment)
+{
+  const auto coarse = toXYZ(*selseg_test::cubeScan(5000, 11));
+  const Cloud fine = interiorWindow(*coarse);
+  for (const bool vertex_mean : {false, true}) {
+    SCOPED_TRACE(vertex_mean);
+    Seg seg;
+    auto params = seg.getParameters();
+    if (vertex_mean)
+      params.edge_triangle_normal = pcl::selective_seg::EdgeTriangleNormal::VertexMean;
+    seg.setParameters(params);
+    const double voxel = extractFirst(seg, coarse);
+    if (!vertex_mean)
+      seg.setMaxMergeAngle(20.0 * M_PI / 180.0);
+    std::vector<pcl::PointIndices> clusters;
+    ASSERT_TRUE(seg.update(fine, clusters));
+    EXPECT_TRUE(seg.getUpdateStatistics().incremental);
+    EXPECT_GT(seg.getUpdateStatistics().kept_leaves, 0u);
+    EXPECT_EQ(seg.getUpdateStatistics().replayed_segments, 0u);
+    Seg ref;
+    ref.setParameters(seg.getParameters());
+    reference(concat(*coarse, fine), voxel, ref);
+    expectSameResult(seg, ref);
+  }
 }
 
 TEST(SelectiveSegmentationUpdate, RepeatedUpdatesAndAnyOrderOfTheNewPoints)
@@ -375,8 +417,10 @@ TEST(SelectiveSegmentationUpdate, NothingNewChangesNothing)
   EXPECT_TRUE(seg.getUpdateStatistics().incremental);
   EXPECT_EQ(seg.getUpdateStatistics().new_triangles, 0u);
   EXPECT_EQ(seg.getResult().labels, labels);
-  // Every leaf kept: no voxel changed.
+  // Every leaf kept: no voxel changed; every segment taken over.
   EXPECT_EQ(seg.getUpdateStatistics().kept_leaves, seg.getResult().leaves.size());
+  EXPECT_EQ(seg.getUpdateStatistics().replayed_segments,
+            seg.getResult().segments.size());
 }
 
 TEST(SelectiveSegmentationUpdate, RingNormalsAndVertexMeanEdgeTestAreUpdatedInPlace)

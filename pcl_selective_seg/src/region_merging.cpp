@@ -113,28 +113,6 @@ struct GrowingSegment {
   }
 };
 
-/** Seeds, largest first (number of vertices); ties by leaf index. */
-std::vector<pcl::index_t>
-seedOrder(const std::vector<pcl::index_t>& vertex_leaf, std::size_t num_leaves)
-{
-  std::vector<std::uint32_t> size(num_leaves, 0);
-  std::uint32_t largest = 0;
-  for (const auto l : vertex_leaf)
-    if (l >= 0)
-      largest = std::max(largest, ++size[l]);
-  // A counting sort by size, largest first; leaves of one size in increasing order (the
-  // order of a stable sort of 0, 1, ... by decreasing size).
-  std::vector<std::size_t> first(static_cast<std::size_t>(largest) + 2, 0);
-  for (const auto n : size)
-    ++first[largest - n + 1];
-  for (std::size_t k = 1; k < first.size(); ++k)
-    first[k] += first[k - 1];
-  std::vector<pcl::index_t> order(num_leaves);
-  for (std::size_t l = 0; l < num_leaves; ++l)
-    order[first[largest - size[l]]++] = static_cast<pcl::index_t>(l);
-  return order;
-}
-
 /** A triangle listed under a leaf, with the leaves of its vertices (-1: none) kept
  * beside it: the growth reads them for every triangle it visits, and a copy next to
  * the triangle id saves it three scattered reads per visit. An edge-on triangle (never
@@ -209,6 +187,8 @@ struct SharedState {
   bool own(pcl::index_t l) const { return leaf_segment[l] == k; }
   /** A held leaf met (nothing to note here). */
   void metHeld(pcl::index_t) const {}
+  /** Whether a leaf is held, as a segment taken over needs (SegmentReplay). */
+  bool requireHeld(pcl::index_t l) const { return claimed(l); }
   void claim(pcl::index_t l) { leaf_segment[l] = k; }
 };
 
@@ -216,7 +196,9 @@ struct SharedState {
  * last window left it (read only), plus the segments this thread grew in this window
  * (an overlay of window-local ids + 1; 0: none). The leaves the growth finds held by
  * another segment of this window go, once each, to \a held: with the leaves it claimed,
- * all that its outcome depends on besides the input (see SeedMerger::run()). */
+ * all that its outcome depends on besides the input (see SeedMerger::run()). A segment
+ * taken over (SegmentReplay) puts there the leaves it needs held that the shared state
+ * does not hold. */
 struct OverlayState {
   const std::vector<pcl::index_t>& leaf_segment;
   std::vector<std::uint16_t>& overlay;
@@ -234,6 +216,16 @@ struct OverlayState {
       return;
     noted[l] = 1;
     held.push_back(l);
+  }
+  /** A leaf a segment taken over needs held (SegmentReplay): noted unless the shared
+   * state holds it already, to be checked when the segment is committed. */
+  bool requireHeld(pcl::index_t l)
+  {
+    if (leaf_segment[l] < 0 && !noted[l]) {
+      noted[l] = 1;
+      held.push_back(l);
+    }
+    return true;
   }
   void claim(pcl::index_t l) { overlay[l] = k; }
 };
@@ -320,6 +312,91 @@ private:
   double cos_edge_;
 };
 
+/** Previous segments taken over instead of grown (MergeReplay). */
+class SegmentReplay {
+public:
+  SegmentReplay(const MergeInput& in, const LeafTriangles& adjacency)
+      : in_(in)
+      , adjacency_(adjacency)
+  {
+    if (!in.replay || !in.replay->leaf_segment || !in.replay->segment_seed ||
+        !in.replay->segment_normals)
+      return;
+    const MergeReplay& r = *in.replay;
+    const std::size_t num_leaves = numLeaves(in);
+    const std::size_t num_segments = r.segment_seed->size();
+    if (r.leaf_segment->size() != num_leaves ||
+        r.segment_normals->size() != num_segments)
+      return;
+    // The leaves of each previous segment that may be taken over, in leaf order.
+    offsets_.assign(num_segments + 1, 0);
+    for (const auto s : *r.leaf_segment)
+      if (s >= 0 && static_cast<std::size_t>(s) < num_segments &&
+          (*r.segment_seed)[s] >= 0)
+        ++offsets_[s + 1];
+    for (std::size_t k = 1; k <= num_segments; ++k)
+      offsets_[k] += offsets_[k - 1];
+    leaves_.resize(offsets_[num_segments]);
+    std::vector<std::size_t> next(offsets_.begin(), offsets_.end() - 1);
+    for (std::size_t l = 0; l < num_leaves; ++l) {
+      const auto s = (*r.leaf_segment)[l];
+      if (s >= 0 && static_cast<std::size_t>(s) < num_segments &&
+          (*r.segment_seed)[s] >= 0)
+        leaves_[next[s]++] = static_cast<pcl::index_t>(l);
+    }
+    active_ = true;
+  }
+
+  bool active() const { return active_; }
+
+  /** Takes over the previous segment grown from \a seed when the state allows it
+   * (MergeReplay): claims its leaves, notes the held leaves it depends on, and returns
+   * true with its normal and leaves. False, with the state as it was but for held
+   * leaves noted, otherwise. */
+  template <typename State>
+  bool take(pcl::index_t seed,
+            State& state,
+            Eigen::Vector3d& normal,
+            const pcl::index_t*& first,
+            const pcl::index_t*& last) const
+  {
+    const MergeReplay& r = *in_.replay;
+    const auto& leaf_segment = *r.leaf_segment;
+    const pcl::index_t s = leaf_segment[seed];
+    if (s < 0 || (*r.segment_seed)[s] != seed)
+      return false;
+    first = leaves_.data() + offsets_[s];
+    last = leaves_.data() + offsets_[s + 1];
+    for (const pcl::index_t* l = first; l != last; ++l)
+      if (state.claimed(*l))
+        return false;
+    for (const pcl::index_t* l = first; l != last; ++l) {
+      const auto end = adjacency_.offsets[*l + 1];
+      for (auto i = adjacency_.offsets[*l]; i < end; ++i)
+        for (const auto other : adjacency_.entries[i].leaves) {
+          if (other < 0)
+            continue;
+          const pcl::index_t o = leaf_segment[other];
+          if (o == s || o > s)
+            continue; // S's own, or free when S grew: either way not taken
+          if (!state.requireHeld(other))
+            return false; // held when S grew (or changed): must be held now
+        }
+    }
+    for (const pcl::index_t* l = first; l != last; ++l)
+      state.claim(*l);
+    normal = (*r.segment_normals)[s].cast<double>();
+    return true;
+  }
+
+private:
+  const MergeInput& in_;
+  const LeafTriangles& adjacency_;
+  bool active_ = false;
+  std::vector<std::size_t> offsets_; ///< #S + 1 into leaves_
+  std::vector<pcl::index_t> leaves_;
+};
+
 /** One thread's segments grown ahead of their turn in a window of the seed order, from
  * the seeds of its part of the leaves. */
 struct Speculation {
@@ -328,6 +405,7 @@ struct Speculation {
     std::uint32_t claimed_end; ///< its leaves: claimed[previous end, claimed_end)
     std::uint32_t held_end;    ///< held[previous end, held_end)
     Eigen::Vector3d normal;
+    bool replayed; ///< taken over from the previous merge (SegmentReplay)
   };
   std::vector<Segment> segments;
   std::vector<pcl::index_t> claimed;
@@ -338,7 +416,12 @@ struct Speculation {
 
 class SeedMerger {
 public:
-  explicit SeedMerger(const MergeInput& in) : in_(in), adjacency_(in) {}
+  explicit SeedMerger(const MergeInput& in)
+      : in_(in)
+      , adjacency_(in)
+      , replay_(in, adjacency_)
+  {
+  }
 
   /** The seeds in order, each unassigned one growing a segment.
    *
@@ -355,12 +438,17 @@ public:
    * left alone whether free or held), so it makes the same decisions in the same order
    * and ends with the same normal. Otherwise the segment grows again there, over the
    * true state. The result is the sequential run's, bit for bit, for any thread count;
-   * the windows bound the memory the threads' notes take. */
+   * the windows bound the memory the threads' notes take.
+   *
+   * With MergeInput::replay, a previous segment is taken over at its seed's turn, in
+   * place of its growth, when the state allows (SegmentReplay); ahead of its turn, the
+   * leaves it needs held are checked when it is committed, like a grown segment's. */
   void run(std::vector<pcl::index_t>& leaf_segment, Vector3fVector& segment_normals)
   {
     const std::size_t num_leaves = numLeaves(in_);
     leaf_segment.assign(num_leaves, -1);
     segment_normals.clear();
+    num_replayed_ = 0;
     const std::vector<pcl::index_t> order = seedOrder(*in_.vertex_leaf, num_leaves);
     const int threads = detail::threadCount(in_.num_threads);
     const std::size_t parts =
@@ -369,7 +457,13 @@ public:
     const auto growHere = [&](pcl::index_t seed) {
       const auto k = static_cast<pcl::index_t>(segment_normals.size());
       SharedState state{leaf_segment, k};
-      segment_normals.push_back(growth.grow(seed, state).cast<float>());
+      Eigen::Vector3d normal;
+      const pcl::index_t *first = nullptr, *last = nullptr;
+      if (replay_.active() && replay_.take(seed, state, normal, first, last))
+        ++num_replayed_;
+      else
+        normal = growth.grow(seed, state);
+      segment_normals.push_back(normal.cast<float>());
     };
     if (parts < 2 || num_leaves < kMinParallelLeaves) {
       for (const auto seed : order)
@@ -419,6 +513,7 @@ public:
           for (std::size_t c = claimed_begin; c < grown->claimed_end; ++c)
             leaf_segment[mine.claimed[c]] = k;
           segment_normals.push_back(grown->normal.cast<float>());
+          num_replayed_ += grown->replayed;
           continue;
         }
         growHere(seed);
@@ -429,6 +524,12 @@ public:
       w = w_end;
       window = std::min(2 * window, kWindow);
     }
+  }
+
+  /** Segments the last run() took over from MergeInput::replay. */
+  std::size_t numReplayed() const
+  {
+    return num_replayed_;
   }
 
 private:
@@ -468,11 +569,20 @@ private:
       const std::size_t held_begin = out.held.size();
       Speculation::Segment s;
       s.seed = seed;
-      s.normal = growth.grow(seed, state);
+      const pcl::index_t *taken = nullptr, *taken_end = nullptr;
+      s.replayed =
+          replay_.active() && replay_.take(seed, state, s.normal, taken, taken_end);
+      if (!s.replayed) {
+        for (std::size_t h = held_begin; h < out.held.size(); ++h)
+          out.noted[out.held[h]] = 0;
+        out.held.resize(held_begin);
+        s.normal = growth.grow(seed, state);
+        taken = growth.queue().data();
+        taken_end = taken + growth.queue().size();
+      }
       for (std::size_t h = held_begin; h < out.held.size(); ++h)
         out.noted[out.held[h]] = 0;
-      const auto& queue = growth.queue();
-      out.claimed.insert(out.claimed.end(), queue.begin(), queue.end());
+      out.claimed.insert(out.claimed.end(), taken, taken_end);
       s.claimed_end = static_cast<std::uint32_t>(out.claimed.size());
       s.held_end = static_cast<std::uint32_t>(out.held.size());
       out.segments.push_back(s);
@@ -496,16 +606,42 @@ private:
 
   const MergeInput& in_;
   LeafTriangles adjacency_;
+  SegmentReplay replay_;
+  std::size_t num_replayed_ = 0;
 };
 
 } // namespace
+
+std::vector<pcl::index_t>
+seedOrder(const std::vector<pcl::index_t>& vertex_leaf, std::size_t num_leaves)
+{
+  std::vector<std::uint32_t> size(num_leaves, 0);
+  std::uint32_t largest = 0;
+  for (const auto l : vertex_leaf)
+    if (l >= 0)
+      largest = std::max(largest, ++size[l]);
+  // A counting sort by size, largest first; leaves of one size in increasing order (the
+  // order of a stable sort of 0, 1, ... by decreasing size).
+  std::vector<std::size_t> first(static_cast<std::size_t>(largest) + 2, 0);
+  for (const auto n : size)
+    ++first[largest - n + 1];
+  for (std::size_t k = 1; k < first.size(); ++k)
+    first[k] += first[k - 1];
+  std::vector<pcl::index_t> order(num_leaves);
+  for (std::size_t l = 0; l < num_leaves; ++l)
+    order[first[largest - size[l]]++] = static_cast<pcl::index_t>(l);
+  return order;
+}
 
 void
 mergeSeedSegments(const MergeInput& input,
                   std::vector<pcl::index_t>& leaf_segment,
                   Vector3fVector& segment_normals)
 {
-  SeedMerger(input).run(leaf_segment, segment_normals);
+  SeedMerger merger(input);
+  merger.run(leaf_segment, segment_normals);
+  if (input.replay)
+    input.replay->num_replayed = merger.numReplayed();
 }
 
 void

@@ -97,6 +97,8 @@ BM_Update(benchmark::State& state)
   state.counters["incremental"] = u.incremental;
   state.counters["replaced_triangles"] = static_cast<double>(u.replaced_triangles);
   state.counters["kept_leaves"] = static_cast<double>(u.kept_leaves);
+  state.counters["replayed_segments"] = static_cast<double>(u.replayed_segments);
+  state.counters["segments"] = static_cast<double>(seg.getResult().segments.size());
   state.counters["leaves"] = static_cast<double>(seg.getResult().leaves.size());
   state.counters["points"] = static_cast<double>(s.all->size());
 }

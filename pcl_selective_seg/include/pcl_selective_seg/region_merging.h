@@ -19,6 +19,35 @@
 namespace pcl {
 namespace selective_seg {
 
+/** \brief A previous merge whose segments the seed merging may take over as they were
+ * instead of growing them again (SelectiveSegmentation::update()).
+ *
+ * A previous segment S is taken over at its seed's turn when (1) every leaf of S is a
+ * leaf of this merge unchanged: the same vertices with the same normals and areas, so
+ * the same leaf normal and area, and the same triangles at its vertices, with the same
+ * facet normals and edge-on flags, in the same relative order; (2) all of S's leaves
+ * are free; (3) every other leaf that shares a listed triangle with a leaf of S is
+ * held when it is changed or when its previous segment is numbered below S (it was
+ * held when S grew). S's growth reads nothing else: a leaf of a later previous segment
+ * was free when S grew and was not taken, and whether it is free or held now it is not
+ * taken either. So the growth would make S's decisions in S's order and end with S's
+ * normal: taking S over gives the merge's result bit for bit. The caller vouches for
+ * (1) and for the merge parameters (the same angles and weights, facet normals for the
+ * edge test); the merging checks (2) and (3) at each seed's turn.
+ */
+struct MergeReplay {
+  /** \#L of this merge: the previous segment (its number) of each unchanged leaf, -1
+   * for a changed leaf. */
+  const std::vector<pcl::index_t>* leaf_segment = nullptr;
+  /** \#S of the previous merge: the seed of each previous segment whose leaves are
+   * all unchanged, as a leaf of this merge; -1 for the others. */
+  const std::vector<pcl::index_t>* segment_seed = nullptr;
+  /** \#S of the previous merge: its segment normals (the merge's output). */
+  const Vector3fVector* segment_normals = nullptr;
+  /** Output: the segments taken over. */
+  std::size_t num_replayed = 0;
+};
+
 /** \brief Inputs of the seed merging (paper, Sec. III.D), as parallel arrays. */
 struct MergeInput {
   const Vector3fVector* leaf_normals = nullptr; ///< \#L unit voxel normals N_v (eq. 4)
@@ -42,6 +71,9 @@ struct MergeInput {
   /** Threads for building the incidence lists and for growing seeds ahead of their
    * turn (0: defaultThreads()). The result does not depend on it. */
   int num_threads = 1;
+  /** Optional: a previous merge whose unchanged segments are taken over (MergeReplay);
+   * the result is the same as without it. */
+  MergeReplay* replay = nullptr;
 };
 
 /** \brief Merge the seed segments (octree leaves) across valid edge triangles.
@@ -69,6 +101,16 @@ struct MergeInput {
 PCL_EXPORTS void mergeSeedSegments(const MergeInput& input,
                                    std::vector<pcl::index_t>& leaf_segment,
                                    Vector3fVector& segment_normals);
+
+/** \brief The order in which mergeSeedSegments() takes the seeds: most vertices first,
+ * ties by leaf index. A segment grows from its leaf that comes first in this order,
+ * and the segments grow (and are numbered) in the order of their seeds.
+ *
+ * \param[in] vertex_leaf \#V leaf of each vertex, -1: none
+ * \param[in] num_leaves \#L
+ */
+PCL_EXPORTS std::vector<pcl::index_t>
+seedOrder(const std::vector<pcl::index_t>& vertex_leaf, std::size_t num_leaves);
 
 /** \brief Label and class of each triangle (eq. 8) from the final vertex labels.
  *

@@ -72,6 +72,9 @@ struct Segment {
   std::uint32_t label = 0;    ///< label >= 1; labels are ranked by size, largest first
   std::size_t num_points = 0; ///< input points with this label
   Eigen::Vector3f normal = Eigen::Vector3f::Zero(); ///< N_S (eq. 7), toward the sensor
+  /** N_S in the sensor frame, as the merge computed it (normal is it turned to the
+   * cloud frame); update() takes segments over with it. */
+  Eigen::Vector3f sensor_normal = Eigen::Vector3f::Zero();
   double area = 0.0;          ///< sum of A_v over its leaves [m^2]
   std::size_t num_leaves = 0; ///< octree leaves merged into it
 };

@@ -23,6 +23,8 @@
 namespace pcl {
 namespace selective_seg {
 
+struct MergeReplay; // region_merging.h
+
 /** \brief What the last SelectiveSegmentation::update() changed. */
 struct UpdateStatistics {
   /** The mesh and normals were updated in place; false: the pipeline ran from scratch
@@ -37,6 +39,10 @@ struct UpdateStatistics {
   /** Octree leaves kept from the previous result: those under nodes whose finest
    * voxels hold no new, moved or changed vertex (the rest are computed again). */
   std::size_t kept_leaves = 0;
+  /** Segments taken over from the previous merge instead of grown again: those whose
+   * leaves were all kept and whose neighbourhood is in the state it was when they grew
+   * (MergeReplay). */
+  std::size_t replayed_segments = 0;
 };
 
 /** \brief Segmentation of a 3-D surface point cloud seen from one sensor viewpoint into
@@ -314,6 +320,28 @@ private:
   /** update(): the previous octree's leaves and the positions changed since, for
    * buildOctree() to keep what did not change; empty otherwise. */
   typename Octree::PreviousLeaves previous_leaves_;
+  /** The last merge, for update() to take over the segments whose leaves the octree
+   * kept (MergeReplay): its parameters, kept from the merge, and during update() the
+   * segment of each previous leaf, the seeds and the segment normals in the order the
+   * segments grew (notePreviousSegments()). */
+  struct PreviousMerge {
+    std::vector<pcl::index_t> leaf_segment;
+    std::vector<pcl::index_t> segment_seed;
+    Vector3fVector segment_normals;
+    SelectiveSegmentationParameters params;
+  };
+  PreviousMerge previous_merge_;
+
+  /** \brief update(): the previous merge's segment of each previous leaf, their seeds
+   * and normals, from the result's leaves and segments and the seed order; left empty
+   * when the result does not tell. */
+  void notePreviousSegments();
+
+  /** \brief The replay of previous_merge_ over the current octree's leaves, when it
+   * kept some and the merge parameters are the same; false otherwise. */
+  bool prepareReplay(MergeReplay& replay,
+                     std::vector<pcl::index_t>& leaf_segment,
+                     std::vector<pcl::index_t>& segment_seed) const;
 };
 
 } // namespace selective_seg

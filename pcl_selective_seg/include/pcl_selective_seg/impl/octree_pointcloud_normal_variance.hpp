@@ -692,6 +692,7 @@ OctreePointCloudNormalVariance<PointT>::computeAdaptiveLeaves(
           AdaptiveLeaf leaf = previous.leaves[k];
           leaf.begin = node.begin + (leaf.begin - previous_begin);
           leaf.end = node.begin + (leaf.end - previous_begin);
+          leaf.kept_from = static_cast<std::int32_t>(k);
           leaves_[slot[i] + (k - kept[i].first)] = leaf;
         }
         continue;

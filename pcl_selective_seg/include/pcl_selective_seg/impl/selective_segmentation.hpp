@@ -356,6 +356,7 @@ SelectiveSegmentation<PointT>::rankSegments(
     result_.segments[r].label = static_cast<std::uint32_t>(r + 1);
     result_.segments[r].num_points = sizes[order[r]];
     result_.segments[r].normal = to_cloud * segment_normals[order[r]];
+    result_.segments[r].sensor_normal = segment_normals[order[r]];
   }
   // Per-point labels and the counts of labeled, shared-vertex and normal-less points.
   result_.labels.resize(input_->size());
@@ -480,9 +481,18 @@ SelectiveSegmentation<PointT>::mergeAndLabel()
   in.segment_normal_weight = params_.segment_normal_weight;
   in.max_edge_triangle_angle = params_.max_edge_triangle_angle;
   in.num_threads = numThreads();
+  MergeReplay replay;
+  std::vector<pcl::index_t> replay_leaf_segment, replay_seed;
+  if (prepareReplay(replay, replay_leaf_segment, replay_seed))
+    in.replay = &replay;
   std::vector<pcl::index_t> leaf_segment;
   Vector3fVector segment_normals;
   mergeSeedSegments(in, leaf_segment, segment_normals);
+  if (in.replay)
+    update_stats_.replayed_segments = replay.num_replayed;
+  std::vector<pcl::index_t>().swap(replay_leaf_segment);
+  std::vector<pcl::index_t>().swap(replay_seed);
+  previous_merge_ = PreviousMerge();
 
   const auto num_vertices = static_cast<std::ptrdiff_t>(vertex_leaf_.size());
   std::vector<pcl::index_t> vertex_segment(vertex_leaf_.size());
@@ -500,6 +510,92 @@ SelectiveSegmentation<PointT>::mergeAndLabel()
   for (std::ptrdiff_t v = 0; v < num_vertices; ++v)
     vertex_labels[v] = vertex_segment[v] >= 0 ? segment_label[vertex_segment[v]] : 0;
   fillMeshAndLeaves(vertex_labels, leaf_segment, segment_label);
+  // For update(): the merge's parameters; the rest of it is read from the result when
+  // it is needed (notePreviousSegments()).
+  previous_merge_.params = params_;
+}
+
+template <typename PointT>
+void
+SelectiveSegmentation<PointT>::notePreviousSegments()
+{
+  // The result's leaves (their labels) and the vertex leaves are still the previous
+  // run's. The merge numbered its segments in the order they grew: a segment grew from
+  // its leaf that comes first in the seed order, so walking that order, each label met
+  // for the first time is the next segment, grown from that leaf.
+  PreviousMerge& previous = previous_merge_;
+  previous.leaf_segment.clear();
+  previous.segment_seed.clear();
+  previous.segment_normals.clear();
+  const std::size_t num_leaves = result_.leaves.size();
+  const std::size_t num_segments = result_.segments.size();
+  if (num_leaves == 0 || previous_leaves_.leaves.size() != num_leaves)
+    return;
+  std::vector<pcl::index_t> label_segment(num_segments + 1, -1);
+  previous.leaf_segment.resize(num_leaves);
+  previous.segment_seed.reserve(num_segments);
+  for (const pcl::index_t l : seedOrder(vertex_leaf_, num_leaves)) {
+    const std::uint32_t label = result_.leaves[l].label;
+    if (label == 0 || label > num_segments) { // not a merge's result: no replay
+      previous = PreviousMerge();
+      return;
+    }
+    if (label_segment[label] < 0) {
+      label_segment[label] = static_cast<pcl::index_t>(previous.segment_seed.size());
+      previous.segment_seed.push_back(l);
+      previous.segment_normals.push_back(result_.segments[label - 1].sensor_normal);
+    }
+    previous.leaf_segment[l] = label_segment[label];
+  }
+  if (previous.segment_seed.size() != num_segments)
+    previous = PreviousMerge();
+}
+
+template <typename PointT>
+bool
+SelectiveSegmentation<PointT>::prepareReplay(
+    MergeReplay& replay,
+    std::vector<pcl::index_t>& leaf_segment,
+    std::vector<pcl::index_t>& segment_seed) const
+{
+  // A kept leaf holds the same vertices, with the same normals and areas, as the
+  // previous leaf it was kept from, and no corner of a new or changed triangle (those
+  // are among the positions the octree was told changed): every triangle at its
+  // vertices is an old one, with its facet normal and edge-on flag, in the same
+  // relative order (the canonical order over vertex numbers that keep their order).
+  // A vertex-mean edge normal would change with a neighbour's vertex normal.
+  const PreviousMerge& previous = previous_merge_;
+  const SelectiveSegmentationParameters& was = previous.params;
+  if (octree_->getNumKeptLeaves() == 0 || previous.leaf_segment.empty() ||
+      params_.edge_triangle_normal != EdgeTriangleNormal::Facet ||
+      was.edge_triangle_normal != EdgeTriangleNormal::Facet ||
+      was.max_merge_angle != params_.max_merge_angle ||
+      was.max_edge_triangle_angle != params_.max_edge_triangle_angle ||
+      was.segment_normal_weight != params_.segment_normal_weight)
+    return false;
+  const auto& leaves = octree_->getAdaptiveLeaves();
+  const std::size_t num_previous = previous.leaf_segment.size();
+  // Each previous leaf's number now, -1 when it was not kept.
+  std::vector<pcl::index_t> now(num_previous, -1);
+  leaf_segment.assign(leaves.size(), -1);
+  for (std::size_t l = 0; l < leaves.size(); ++l) {
+    const std::int32_t k = leaves[l].kept_from;
+    if (k < 0 || static_cast<std::size_t>(k) >= num_previous)
+      continue;
+    now[k] = static_cast<pcl::index_t>(l);
+    leaf_segment[l] = previous.leaf_segment[k];
+  }
+  // A previous segment can be taken over only when all its leaves were kept.
+  segment_seed.resize(previous.segment_seed.size());
+  for (std::size_t s = 0; s < segment_seed.size(); ++s)
+    segment_seed[s] = now[previous.segment_seed[s]];
+  for (std::size_t k = 0; k < num_previous; ++k)
+    if (now[k] < 0)
+      segment_seed[previous.leaf_segment[k]] = -1;
+  replay.leaf_segment = &leaf_segment;
+  replay.segment_seed = &segment_seed;
+  replay.segment_normals = &previous.segment_normals;
+  return true;
 }
 
 template <typename PointT>
@@ -509,6 +605,7 @@ SelectiveSegmentation<PointT>::extract(std::vector<pcl::PointIndices>& clusters)
   clusters.clear();
   clearOutputs();
   previous_leaves_ = typename Octree::PreviousLeaves(); // from scratch
+  previous_merge_ = PreviousMerge();
   pcl::StopWatch total;
   if (!initCompute()) {
     this->deinitCompute();

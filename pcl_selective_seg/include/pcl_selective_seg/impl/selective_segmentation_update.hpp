@@ -111,6 +111,7 @@ SelectiveSegmentation<PointT>::updateMesh(std::size_t first_new_point, bool& fai
   previous_leaves_ = typename Octree::PreviousLeaves();
   if (octree_ && params_.normal_rings == 1) {
     previous_leaves_ = octree_->getPreviousLeaves();
+    notePreviousSegments();
     if (!moved.empty()) {
       std::vector<std::uint8_t> is_moved(
           delaunay_.getTriangulation().vertex_positions.size(), 0);
