@@ -258,6 +258,30 @@ TEST(SelectiveSegmentationUpdate, LeavesAwayFromTheNewPointsAreKept)
   expectSameResult(seg, ref);
 }
 
+// Over 1,024 leaves the merge grows and takes over segments ahead of their turn on
+// several threads (checked at commit): the same result as extract() on the union.
+TEST(SelectiveSegmentationUpdate, SegmentsTakenOverAheadOfTheirTurnOnThreads)
+{
+  const auto coarse = toXYZ(*selseg_test::cubeScan(40000, 15));
+  const Cloud fine = interiorWindow(*coarse);
+  ASSERT_GT(fine.size(), 500u);
+  Seg seg;
+  auto params = seg.getParameters();
+  params.num_threads = 3;
+  seg.setParameters(params);
+  const double voxel = extractFirst(seg, coarse);
+  ASSERT_GE(seg.getResult().leaves.size(), 1024u); // the size that runs on threads
+  std::vector<pcl::PointIndices> clusters;
+  ASSERT_TRUE(seg.update(fine, clusters));
+  const auto& stats = seg.getUpdateStatistics();
+  EXPECT_TRUE(stats.incremental);
+  EXPECT_GT(stats.replayed_segments, seg.getResult().segments.size() / 2);
+  Seg ref;
+  ref.setParameters(params);
+  reference(concat(*coarse, fine), voxel, ref);
+  expectSameResult(seg, ref);
+}
+
 // Segments are taken over only from a merge with the same parameters and the facet
 // normals in the edge test: a changed merge angle, or vertex-mean edge normals (which
 // change with the neighbours' vertex normals), keep the leaves but grow every segment.
