@@ -217,14 +217,11 @@ struct OverlayState {
     noted[l] = 1;
     held.push_back(l);
   }
-  /** A leaf a segment taken over needs held (SegmentReplay): noted unless the shared
-   * state holds it already, to be checked when the segment is committed. */
+  /** A leaf a segment taken over needs held (SegmentReplay), before it claims any:
+   * noted like a held leaf met, to be checked when the segment is committed. */
   bool requireHeld(pcl::index_t l)
   {
-    if (leaf_segment[l] < 0 && !noted[l]) {
-      noted[l] = 1;
-      held.push_back(l);
-    }
+    metHeld(l);
     return true;
   }
   void claim(pcl::index_t l) { overlay[l] = k; }
@@ -326,13 +323,19 @@ public:
     const std::size_t num_leaves = numLeaves(in);
     const std::size_t num_segments = r.segment_seed->size();
     if (r.leaf_segment->size() != num_leaves ||
-        r.segment_normals->size() != num_segments)
-      return;
+        r.segment_normals->size() != num_segments ||
+        std::any_of(
+            r.leaf_segment->begin(), r.leaf_segment->end(), [&](pcl::index_t s) {
+              return s >= 0 && static_cast<std::size_t>(s) >= num_segments;
+            }))
+      return; // inconsistent: nothing is taken over
+    const auto replayable = [&](pcl::index_t s) {
+      return s >= 0 && (*r.segment_seed)[s] >= 0;
+    };
     // The leaves of each previous segment that may be taken over, in leaf order.
     offsets_.assign(num_segments + 1, 0);
     for (const auto s : *r.leaf_segment)
-      if (s >= 0 && static_cast<std::size_t>(s) < num_segments &&
-          (*r.segment_seed)[s] >= 0)
+      if (replayable(s))
         ++offsets_[s + 1];
     for (std::size_t k = 1; k <= num_segments; ++k)
       offsets_[k] += offsets_[k - 1];
@@ -340,8 +343,7 @@ public:
     std::vector<std::size_t> next(offsets_.begin(), offsets_.end() - 1);
     for (std::size_t l = 0; l < num_leaves; ++l) {
       const auto s = (*r.leaf_segment)[l];
-      if (s >= 0 && static_cast<std::size_t>(s) < num_segments &&
-          (*r.segment_seed)[s] >= 0)
+      if (replayable(s))
         leaves_[next[s]++] = static_cast<pcl::index_t>(l);
     }
     active_ = true;

@@ -263,9 +263,9 @@ protected:
 
   /** \brief update(): triangle and vertex normals where the mesh changed, reusing the
    * previous result's triangle normals and areas (taken from \a old_normals and
-   * \a old_areas) where it can. */
+   * \a old_areas) where it can; \a is_moved flags the moved vertices (empty: none). */
   void updateNormals(const DelaunayInsertion& info,
-                     const std::vector<pcl::index_t>& moved_vertices,
+                     const std::vector<std::uint8_t>& is_moved,
                      Vector3fVector& old_normals,
                      std::vector<double>& old_areas);
 

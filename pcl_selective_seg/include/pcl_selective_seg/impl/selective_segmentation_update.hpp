@@ -105,6 +105,13 @@ SelectiveSegmentation<PointT>::updateMesh(std::size_t first_new_point, bool& fai
   std::vector<double> old_areas;
   old_normals.swap(result_.mesh.normals);
   old_areas.swap(result_.mesh.areas);
+  // The moved vertices, flagged (empty when none moved).
+  std::vector<std::uint8_t> is_moved;
+  if (!moved.empty()) {
+    is_moved.assign(delaunay_.getTriangulation().vertex_positions.size(), 0);
+    for (const auto v : moved)
+      is_moved[v] = 1;
+  }
   // The octree's leaves, for buildOctree() to keep where nothing changed (k-ring
   // normals change beyond the changed triangles' corners: not kept then), and the old
   // positions of the moved vertices (their old voxels lost them).
@@ -113,10 +120,6 @@ SelectiveSegmentation<PointT>::updateMesh(std::size_t first_new_point, bool& fai
     previous_leaves_ = octree_->getPreviousLeaves();
     notePreviousSegments();
     if (!moved.empty()) {
-      std::vector<std::uint8_t> is_moved(
-          delaunay_.getTriangulation().vertex_positions.size(), 0);
-      for (const auto v : moved)
-        is_moved[v] = 1;
       const auto& old_positions = *octree_->getInputCloud();
       for (std::size_t v = 0; v < info.old_to_new_point.size(); ++v)
         if (is_moved[info.old_to_new_point[v]])
@@ -133,7 +136,7 @@ SelectiveSegmentation<PointT>::updateMesh(std::size_t first_new_point, bool& fai
   takeTriangulationCounts();
   result_.timings.delaunay = watch.getTimeSeconds();
   watch.reset();
-  updateNormals(info, moved, old_normals, old_areas);
+  updateNormals(info, is_moved, old_normals, old_areas);
   if (!publishNormals()) {
     failed = true;
     return false;
@@ -146,7 +149,7 @@ SelectiveSegmentation<PointT>::updateMesh(std::size_t first_new_point, bool& fai
 template <typename PointT>
 void
 SelectiveSegmentation<PointT>::updateNormals(const DelaunayInsertion& info,
-                                             const std::vector<pcl::index_t>& moved,
+                                             const std::vector<std::uint8_t>& is_moved,
                                              Vector3fVector& old_normals,
                                              std::vector<double>& old_areas)
 {
@@ -156,10 +159,7 @@ SelectiveSegmentation<PointT>::updateNormals(const DelaunayInsertion& info,
   const std::size_t num_vertices = tri.vertex_positions.size();
   // The changed triangles: the new ones and those at a moved vertex.
   std::vector<pcl::index_t> changed = info.new_triangles;
-  if (!moved.empty()) {
-    std::vector<std::uint8_t> is_moved(num_vertices, 0);
-    for (const auto v : moved)
-      is_moved[v] = 1;
+  if (!is_moved.empty()) {
     for (std::size_t t = 0; t < num_triangles; ++t) {
       const Triangle& c = tri.triangles[t];
       if (is_moved[c[0]] || is_moved[c[1]] || is_moved[c[2]])
