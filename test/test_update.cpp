@@ -184,6 +184,30 @@ interiorWindow(const Cloud& coarse)
   return fine;
 }
 
+/** \a coarse extracted with the parameters \a first, then updated with the interior
+ * window of a finer scan under \a then; the result must be extract()'s on the union
+ * under \a then. \a seg holds the result and the update's statistics. */
+void
+updateWithInteriorWindow(
+    const Cloud::Ptr& coarse,
+    const pcl::selective_seg::SelectiveSegmentationParameters& first,
+    const pcl::selective_seg::SelectiveSegmentationParameters& then,
+    Seg& seg)
+{
+  const Cloud fine = interiorWindow(*coarse);
+  ASSERT_GT(fine.size(), 500u);
+  seg.setParameters(first);
+  const double voxel = extractFirst(seg, coarse);
+  seg.setParameters(then);
+  std::vector<pcl::PointIndices> clusters;
+  ASSERT_TRUE(seg.update(fine, clusters));
+  EXPECT_TRUE(seg.getUpdateStatistics().incremental);
+  Seg ref;
+  ref.setParameters(then);
+  reference(concat(*coarse, fine), voxel, ref);
+  expectSameResult(seg, ref);
+}
+
 } // namespace
 
 TEST(SelectiveSegmentationUpdate, RandomFifthOfTheScanEqualsExtractOnTheUnion)
@@ -237,15 +261,11 @@ TEST(SelectiveSegmentationUpdate, FinerScanOfAWindowChangesOnlyItsRegion)
 // which is fitted to the points, and every leaf is made again.)
 TEST(SelectiveSegmentationUpdate, LeavesAwayFromTheNewPointsAreKept)
 {
-  const auto coarse = toXYZ(*selseg_test::cubeScan(5000, 11));
-  const Cloud fine = interiorWindow(*coarse);
-  ASSERT_GT(fine.size(), 500u);
   Seg seg;
-  const double voxel = extractFirst(seg, coarse);
-  std::vector<pcl::PointIndices> clusters;
-  ASSERT_TRUE(seg.update(fine, clusters));
+  const auto params = seg.getParameters();
+  ASSERT_NO_FATAL_FAILURE(updateWithInteriorWindow(
+      toXYZ(*selseg_test::cubeScan(5000, 11)), params, params, seg));
   const auto& stats = seg.getUpdateStatistics();
-  EXPECT_TRUE(stats.incremental);
   const std::size_t leaves = seg.getResult().leaves.size();
   EXPECT_GT(stats.kept_leaves, leaves / 2) << leaves;
   EXPECT_LT(stats.kept_leaves, leaves);
@@ -253,33 +273,20 @@ TEST(SelectiveSegmentationUpdate, LeavesAwayFromTheNewPointsAreKept)
   const std::size_t segments = seg.getResult().segments.size();
   EXPECT_GT(stats.replayed_segments, segments / 2) << segments;
   EXPECT_LT(stats.replayed_segments, segments);
-  Seg ref;
-  reference(concat(*coarse, fine), voxel, ref);
-  expectSameResult(seg, ref);
 }
 
 // Over 1,024 leaves the merge grows and takes over segments ahead of their turn on
 // several threads (checked at commit): the same result as extract() on the union.
 TEST(SelectiveSegmentationUpdate, SegmentsTakenOverAheadOfTheirTurnOnThreads)
 {
-  const auto coarse = toXYZ(*selseg_test::cubeScan(40000, 15));
-  const Cloud fine = interiorWindow(*coarse);
-  ASSERT_GT(fine.size(), 500u);
   Seg seg;
   auto params = seg.getParameters();
   params.num_threads = 3;
-  seg.setParameters(params);
-  const double voxel = extractFirst(seg, coarse);
-  ASSERT_GE(seg.getResult().leaves.size(), 1024u); // the size that runs on threads
-  std::vector<pcl::PointIndices> clusters;
-  ASSERT_TRUE(seg.update(fine, clusters));
-  const auto& stats = seg.getUpdateStatistics();
-  EXPECT_TRUE(stats.incremental);
-  EXPECT_GT(stats.replayed_segments, seg.getResult().segments.size() / 2);
-  Seg ref;
-  ref.setParameters(params);
-  reference(concat(*coarse, fine), voxel, ref);
-  expectSameResult(seg, ref);
+  ASSERT_NO_FATAL_FAILURE(updateWithInteriorWindow(
+      toXYZ(*selseg_test::cubeScan(40000, 15)), params, params, seg));
+  EXPECT_GE(seg.getResult().leaves.size(), 1024u); // the size that runs on threads
+  EXPECT_GT(seg.getUpdateStatistics().replayed_segments,
+            seg.getResult().segments.size() / 2);
 }
 
 // Segments are taken over only from a merge with the same parameters and the facet
@@ -288,26 +295,18 @@ TEST(SelectiveSegmentationUpdate, SegmentsTakenOverAheadOfTheirTurnOnThreads)
 TEST(SelectiveSegmentationUpdate, ChangedMergeParametersReplayNoSegment)
 {
   const auto coarse = toXYZ(*selseg_test::cubeScan(5000, 11));
-  const Cloud fine = interiorWindow(*coarse);
   for (const bool vertex_mean : {false, true}) {
     SCOPED_TRACE(vertex_mean);
     Seg seg;
-    auto params = seg.getParameters();
+    auto first = seg.getParameters();
     if (vertex_mean)
-      params.edge_triangle_normal = pcl::selective_seg::EdgeTriangleNormal::VertexMean;
-    seg.setParameters(params);
-    const double voxel = extractFirst(seg, coarse);
+      first.edge_triangle_normal = pcl::selective_seg::EdgeTriangleNormal::VertexMean;
+    auto then = first;
     if (!vertex_mean)
-      seg.setMaxMergeAngle(20.0 * M_PI / 180.0);
-    std::vector<pcl::PointIndices> clusters;
-    ASSERT_TRUE(seg.update(fine, clusters));
-    EXPECT_TRUE(seg.getUpdateStatistics().incremental);
+      then.max_merge_angle = 20.0 * M_PI / 180.0;
+    ASSERT_NO_FATAL_FAILURE(updateWithInteriorWindow(coarse, first, then, seg));
     EXPECT_GT(seg.getUpdateStatistics().kept_leaves, 0u);
     EXPECT_EQ(seg.getUpdateStatistics().replayed_segments, 0u);
-    Seg ref;
-    ref.setParameters(seg.getParameters());
-    reference(concat(*coarse, fine), voxel, ref);
-    expectSameResult(seg, ref);
   }
 }
 
