@@ -33,7 +33,9 @@ namespace selective_seg {
  * taken either. So the growth would make S's decisions in S's order and end with S's
  * normal: taking S over gives the merge's result bit for bit. The caller vouches for
  * (1) and for the merge parameters (the same angles and weights, facet normals for the
- * edge test); the merging checks (2) and (3) at each seed's turn.
+ * edge test); the merging checks (2) and (3) at each seed's turn. Arrays of the wrong
+ * size, or a leaf's segment beyond the segments given, make it ignored: every segment
+ * grows.
  */
 struct MergeReplay {
   /** \#L of this merge: the previous segment (its number) of each unchanged leaf, -1
