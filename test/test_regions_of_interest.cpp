@@ -278,6 +278,153 @@ TEST(RegionsOfInterest, EmptyAndMismatchedInput)
   EXPECT_TRUE(regions.empty());
 }
 
+// A triangulation, pose or leaves that the segmenter cannot have made: a clear error,
+// or (leaves) passed over, never windows computed from NaN.
+TEST(RegionsOfInterest, BadTriangulationPoseOrLeavesAreRejected)
+{
+  std::vector<RegionOfInterest> regions;
+  const auto run = [&](const GridMesh& g, const Eigen::Affine3f& pose) {
+    return computeRegionsOfInterest(
+        g.result, g.tri, pose, RegionOfInterestParameters(), regions);
+  };
+  const Eigen::Affine3f identity = Eigen::Affine3f::Identity();
+  ASSERT_TRUE(run(makeGrid(10, 6, 0.01, 2), identity));
+  ASSERT_FALSE(regions.empty());
+  for (const double q : {std::numeric_limits<double>::quiet_NaN(),
+                         0.0,
+                         -1e-7,
+                         std::numeric_limits<double>::infinity()}) {
+    GridMesh g = makeGrid(10, 6, 0.01, 2);
+    g.tri.angle_quantization = q;
+    EXPECT_FALSE(run(g, identity)) << "quantization " << q;
+  }
+  Eigen::Affine3f flat = identity;
+  flat.linear().row(2).setZero(); // finite but singular: maps everything to z = 0
+  EXPECT_FALSE(run(makeGrid(10, 6, 0.01, 2), flat));
+  GridMesh g = makeGrid(10, 6, 0.01, 2);
+  g.tri.vertex_positions[7].x() = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_FALSE(run(g, identity));
+  g = makeGrid(10, 6, 0.01, 2);
+  std::swap(g.tri.vertex_angles[0], g.tri.vertex_angles[59]); // theta out of order
+  EXPECT_FALSE(run(g, identity));
+
+  // Leaves with a NaN centre or size are passed over: without edge triangles, a
+  // finest leaf whose normals spread widely marks only the vertices in its voxel.
+  RegionOfInterestParameters p;
+  p.sparse_factor = 0.0;
+  g = makeGrid(10, 6, 0.01, -1);
+  OctreeLeaf leaf;
+  leaf.size = 0.001f;
+  leaf.sigma_theta = 1.0f;
+  leaf.sigma_phi = 1.0f;
+  leaf.centre = g.tri.vertex_positions[20] + Eigen::Vector3f::Constant(0.1f);
+  g.result.leaves.push_back(leaf); // away from every vertex
+  RegionOfInterestStats stats;
+  ASSERT_TRUE(computeRegionsOfInterest(g.result, g.tri, identity, p, regions, &stats));
+  EXPECT_EQ(stats.transition_vertices, 0u);
+  g.result.leaves.back().centre.x() = std::numeric_limits<float>::quiet_NaN();
+  ASSERT_TRUE(computeRegionsOfInterest(g.result, g.tri, identity, p, regions, &stats));
+  EXPECT_EQ(stats.transition_vertices, 0u);
+  EXPECT_TRUE(regions.empty());
+  g.result.leaves.back().centre = g.tri.vertex_positions[20];
+  g.result.leaves.back().size = std::numeric_limits<float>::infinity();
+  ASSERT_TRUE(computeRegionsOfInterest(g.result, g.tri, identity, p, regions, &stats));
+  EXPECT_EQ(stats.transition_vertices, 0u);
+  g.result.leaves.back().size = 0.001f; // the vertex's own voxel: evidence
+  ASSERT_TRUE(computeRegionsOfInterest(g.result, g.tri, identity, p, regions, &stats));
+  EXPECT_EQ(stats.transition_vertices, 1u);
+}
+
+// Evidence in groups below min_component_vertices is ignored, in the priority too: an
+// isolated invalid edge triangle inside a small segment's window leaves it as it was.
+TEST(RegionsOfInterest, IgnoredEvidenceDoesNotRaiseThePriority)
+{
+  RegionOfInterestParameters p;
+  p.sparse_factor = 0.0;
+  p.max_window_size = 1.0;
+  p.small_segment_points = 50;
+  p.min_component_vertices = 4;
+  const int rows = 12;
+  GridMesh g = makeGrid(10, rows, 0.01, -1, {2, 5}); // small segment: rows 2-5
+  std::vector<RegionOfInterest> before, after;
+  RegionOfInterestStats stats;
+  ASSERT_TRUE(computeRegionsOfInterest(
+      g.result, g.tri, Eigen::Affine3f::Identity(), p, before, &stats));
+  ASSERT_EQ(before.size(), 1u);
+  EXPECT_EQ(before[0].reasons, kSmallSegment);
+  const int c = 4, r = 3;
+  const Triangle lone = {c * rows + r, (c + 1) * rows + r, (c + 1) * rows + r + 1};
+  const auto it = std::find(g.tri.triangles.begin(), g.tri.triangles.end(), lone);
+  ASSERT_NE(it, g.tri.triangles.end());
+  g.result.mesh.classes[static_cast<std::size_t>(it - g.tri.triangles.begin())] =
+      TriangleClass::InvalidEdge;
+  ASSERT_TRUE(computeRegionsOfInterest(
+      g.result, g.tri, Eigen::Affine3f::Identity(), p, after, &stats));
+  EXPECT_EQ(stats.transition_vertices, 3u); // found, then ignored
+  ASSERT_EQ(after.size(), 1u);
+  EXPECT_EQ(after[0].reasons, kSmallSegment);
+  EXPECT_EQ(after[0].priority, before[0].priority);
+}
+
+// A window without margin ends on its outermost evidence: those vertices are inside it
+// (counted in num_points and the box), whatever the rounding of angle / quantization.
+TEST(RegionsOfInterest, EvidenceOnTheBorderIsInside)
+{
+  const double q = 1e-7;
+  int a = 100000; // a * q / q < a: a border vertex compared as a / q would fall out
+  while ((a * q) / q >= a)
+    ++a;
+  RegionOfInterestParameters p;
+  p.sparse_factor = 0.0;
+  p.max_window_size = 1.0;
+  p.margin_spacings = 0.0;
+  const int rows = 8;
+  GridMesh g = makeGrid(10, rows, 0.01, 3); // band of invalid triangles, rows 3-4
+  const int shift = a - g.tri.vertex_angles[9 * rows][0]; // last column at a quanta
+  for (std::size_t v = 0; v < g.tri.vertex_angles.size(); ++v) {
+    g.tri.vertex_angles[v][0] += shift;
+    g.tri.vertex_positions[v].x() =
+        static_cast<float>(std::tan(g.tri.vertex_angles[v][0] * q));
+  }
+  std::vector<RegionOfInterest> regions;
+  ASSERT_TRUE(computeRegionsOfInterest(
+      g.result, g.tri, Eigen::Affine3f::Identity(), p, regions));
+  ASSERT_EQ(regions.size(), 1u);
+  EXPECT_EQ(regions[0].theta_max, a * q);
+  EXPECT_EQ(regions[0].num_evidence, 20u); // rows 3 and 4 of the 10 columns
+  EXPECT_EQ(regions[0].num_points, 20u);
+  EXPECT_EQ(regions[0].box_max.x(), g.tri.vertex_positions[9 * rows].x());
+}
+
+// A target step far below the spacing asks for more points than a size_t holds: the
+// estimate saturates, and so does the total; under a point budget nothing fits.
+TEST(RegionsOfInterest, HugeEstimatesSaturate)
+{
+  const GridMesh g = makeGrid(10, 6, 0.01, 2);
+  RegionOfInterestParameters p;
+  p.target_step = 1e-12;
+  std::vector<RegionOfInterest> regions;
+  RegionOfInterestStats stats;
+  ASSERT_TRUE(computeRegionsOfInterest(
+      g.result, g.tri, Eigen::Affine3f::Identity(), p, regions, &stats));
+  ASSERT_FALSE(regions.empty());
+  const std::size_t most = std::numeric_limits<std::size_t>::max();
+  for (const auto& r : regions)
+    EXPECT_EQ(r.estimated_points, most);
+  EXPECT_EQ(stats.selected_points, most);
+  p.max_points = most - 1;
+  ASSERT_TRUE(computeRegionsOfInterest(
+      g.result, g.tri, Eigen::Affine3f::Identity(), p, regions, &stats));
+  EXPECT_TRUE(regions.empty());
+  EXPECT_EQ(stats.over_budget, stats.candidates);
+  // A window size below a nanoradian is refused (its tile numbers would overflow).
+  p = RegionOfInterestParameters();
+  p.max_window_size = 1e-12;
+  std::string why;
+  EXPECT_FALSE(p.validate(&why));
+  EXPECT_NE(why.find("max_window_size"), std::string::npos);
+}
+
 // Hand-computed: a band of invalid edge triangles between phi rows 2 and 3 of a grid of
 // 0.01 rad steps gives one window over the band, widened by half a spacing each side.
 TEST(RegionsOfInterest, WindowOverABandOfInvalidEdgeTriangles)
@@ -687,7 +834,8 @@ TEST_F(CubeRegions, NoMergeableOverlapRemains)
       const double w =
           std::min(a.theta_max, b.theta_max) - std::max(a.theta_min, b.theta_min);
       const double h = std::min(a.phi_max, b.phi_max) - std::max(a.phi_min, b.phi_min);
-      if (w <= 0.0 || h <= 0.0)
+      // Windows that overlap or share a stretch of border meet and may merge.
+      if (w < 0.0 || h < 0.0 || (w == 0.0 && h == 0.0))
         continue;
       const double uw =
           std::max(a.theta_max, b.theta_max) - std::min(a.theta_min, b.theta_min);
@@ -700,7 +848,8 @@ TEST_F(CubeRegions, NoMergeableOverlapRemains)
                           b.theta_max - b.theta_min}) &&
           uh <= std::max(
                     {p.max_window_size, a.phi_max - a.phi_min, b.phi_max - b.phi_min});
-      EXPECT_FALSE(fits && uw * uh <= p.merge_area_ratio * (area_a + area_b - w * h))
+      const double overlap = w > 0.0 && h > 0.0 ? w * h : 0.0;
+      EXPECT_FALSE(fits && uw * uh <= p.merge_area_ratio * (area_a + area_b - overlap))
           << "windows " << i << " and " << j << " should have merged";
     }
 }

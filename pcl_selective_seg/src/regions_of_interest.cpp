@@ -26,6 +26,11 @@ namespace {
 constexpr double kHalfPi = 0.5 * M_PI;
 /** Windows stay this far inside (-pi/2, pi/2), where eq. 1 has an image. */
 constexpr double kEdgeGuard = 1e-6;
+/** Smallest max_window_size: a nanoradian, far below any scan's angular resolution
+ * (the finest angle quantization is 2.5e-8 rad). */
+constexpr double kMinWindowSize = 1e-9;
+/** 2^63: point counts from here up are given as the largest size_t. */
+constexpr double kMaxCount = 9223372036854775808.0;
 
 bool
 reject(std::string* why, const char* name, double value, const char* range)
@@ -194,8 +199,12 @@ markLeafEvidence(const SegmentationResult& result,
   if (!(sigma_threshold > 0.0) || result.leaves.empty())
     return;
   float finest = std::numeric_limits<float>::infinity();
+  // Leaves with a non-finite centre or size (not the segmenter's) are passed over.
+  const auto usable = [](const OctreeLeaf& leaf) {
+    return leaf.size > 0.0f && std::isfinite(leaf.size) && leaf.centre.allFinite();
+  };
   for (const auto& leaf : result.leaves)
-    if (leaf.size > 0.0f)
+    if (usable(leaf))
       finest = std::min(finest, leaf.size);
   if (!std::isfinite(finest))
     return;
@@ -204,7 +213,7 @@ markLeafEvidence(const SegmentationResult& result,
   Eigen::Vector3d origin = Eigen::Vector3d::Zero();
   std::vector<CellKey> cells;
   for (const auto& leaf : result.leaves) {
-    if (!(leaf.size <= finest * (1.0f + 1e-4f)) ||
+    if (!usable(leaf) || !(leaf.size <= finest * (1.0f + 1e-4f)) ||
         !(std::max(leaf.sigma_theta, leaf.sigma_phi) > sigma_threshold))
       continue;
     const Eigen::Vector3d centre = cloud_to_sensor * leaf.centre.cast<double>();
@@ -417,15 +426,19 @@ findEvidence(const SegmentationResult& result,
   return kinds;
 }
 
-/** One window per (kind, mesh-connected component, tile of max_window_size). */
+/** One window per (kind, mesh-connected component, tile of max_window_size).
+ * \a kept receives, per vertex, the kinds of its evidence that are in a component of
+ * at least min_component_vertices (the rest is ignored as noise). */
 std::vector<Window>
 makeTileWindows(const SphericalTriangulation& tri,
                 const std::vector<Eigen::Vector2d>& angles,
                 const std::vector<std::uint8_t>& kinds,
                 const std::vector<double>& spacing,
-                const RegionOfInterestParameters& p)
+                const RegionOfInterestParameters& p,
+                std::vector<std::uint8_t>& kept)
 {
   const std::size_t nv = angles.size();
+  kept.assign(nv, 0);
   // (kind, component, tile theta, tile phi, vertex): sorted, groups are windows.
   using Entry = std::tuple<int, std::size_t, std::int64_t, std::int64_t, pcl::index_t>;
   std::vector<Entry> entries;
@@ -452,6 +465,8 @@ makeTileWindows(const SphericalTriangulation& tri,
       const std::size_t root = sets.find(v);
       if (!(kinds[v] & kind) || size[root] < p.min_component_vertices)
         continue;
+      kept[v] |= kind;
+      // At most pi / 1e-9 (validate()): the tile numbers fit an integer.
       const Eigen::Vector2d tile = (angles[v] - start[root]) / p.max_window_size;
       entries.emplace_back(kind,
                            root,
@@ -619,8 +634,8 @@ RegionOfInterestParameters::validate(std::string* why) const
     return reject(why, "sparse_factor", sparse_factor, "0 or [1, inf)");
   if (min_component_vertices < 1)
     return reject(why, "min_component_vertices", 0.0, "[1, inf)");
-  if (!(max_window_size > 0.0 && max_window_size <= M_PI))
-    return reject(why, "max_window_size", max_window_size, "(0, pi] [rad]");
+  if (!(max_window_size >= kMinWindowSize && max_window_size <= M_PI))
+    return reject(why, "max_window_size", max_window_size, "[1e-9, pi] [rad]");
   if (!(min_window_size >= 0.0 && min_window_size <= max_window_size))
     return reject(
         why, "min_window_size", min_window_size, "[0, max_window_size] [rad]");
@@ -722,21 +737,48 @@ computeRegionsOfInterest(const SegmentationResult& result,
       }
   if (nv == 0)
     return true;
+  const double q = tri.angle_quantization;
+  if (!(std::isfinite(q) && q > 0.0)) {
+    PCL_ERROR(
+        "[pcl::selective_seg::computeRegionsOfInterest] the triangulation's angle "
+        "quantization %g is not a positive step [rad]\n",
+        q);
+    return false;
+  }
+  // The pose's rotation part must be invertible: evidence in the leaves is matched in
+  // the sensor frame.
+  const Eigen::Affine3d to_cloud = sensor_to_cloud.cast<double>();
+  const Eigen::Affine3d to_sensor = to_cloud.inverse();
+  if (!(std::abs(to_cloud.linear().determinant()) > 1e-9) ||
+      !to_sensor.matrix().allFinite()) {
+    PCL_ERROR("[pcl::selective_seg::computeRegionsOfInterest] the sensor pose is not "
+              "invertible (its rotation part is singular)\n");
+    return false;
+  }
+  for (std::size_t v = 0; v < nv; ++v)
+    if (!tri.vertex_positions[v].allFinite() ||
+        (v > 0 && tri.vertex_angles[v][0] < tri.vertex_angles[v - 1][0])) {
+      PCL_ERROR("[pcl::selective_seg::computeRegionsOfInterest] vertex %zu has a "
+                "non-finite position or is out of theta order (vertices are numbered "
+                "in increasing quantized theta)\n",
+                v);
+      return false;
+    }
   std::vector<Eigen::Vector2d> angles(nv);
   for (std::size_t v = 0; v < nv; ++v)
     angles[v] = Eigen::Vector2d(tri.vertex_angles[v][0], tri.vertex_angles[v][1]) *
                 tri.angle_quantization;
   const std::vector<double> spacing = vertexSpacing(tri, angles);
-  const Eigen::Affine3d to_cloud = sensor_to_cloud.cast<double>();
   std::vector<double> strength;
   const std::vector<std::uint8_t> kinds =
-      findEvidence(result, tri, to_cloud.inverse(), angles, spacing, p, strength);
+      findEvidence(result, tri, to_sensor, angles, spacing, p, strength);
   for (const auto k : kinds) {
     st.transition_vertices += (k & kTransition) != 0;
     st.small_segment_vertices += (k & kSmallSegment) != 0;
     st.sparse_vertices += (k & kSparse) != 0;
   }
-  std::vector<Window> windows = makeTileWindows(tri, angles, kinds, spacing, p);
+  std::vector<std::uint8_t> kept;
+  std::vector<Window> windows = makeTileWindows(tri, angles, kinds, spacing, p, kept);
   mergeWindows(windows, p);
   st.candidates = windows.size();
 
@@ -750,7 +792,7 @@ computeRegionsOfInterest(const SegmentationResult& result,
     for (const auto v : ev) {
       local.push_back(spacing[v]);
       const double s2 = spacing[v] * spacing[v];
-      weighted += kindWeight(kinds[v], strength[v], p) * s2;
+      weighted += kindWeight(kept[v], strength[v], p) * s2;
       covered += s2;
     }
     RegionOfInterest r;
@@ -770,20 +812,24 @@ computeRegionsOfInterest(const SegmentationResult& result,
     }
     const double area = w.area();
     r.solid_angle = windowSolidAngle(r.theta_min, r.theta_max, r.phi_min, r.phi_max);
-    r.estimated_points = static_cast<std::size_t>(
-        std::llround(p.sample_yield * area / (r.suggested_step * r.suggested_step)));
+    // Saturated: a tiny target step can ask for more samples than a size_t holds.
+    const double estimate =
+        std::round(p.sample_yield * area / (r.suggested_step * r.suggested_step));
+    r.estimated_points = estimate < kMaxCount ? static_cast<std::size_t>(estimate)
+                                              : std::numeric_limits<std::size_t>::max();
     // Vertices are numbered in increasing quantized theta: the window's are a range.
-    const double q = tri.angle_quantization;
-    const auto first =
-        std::lower_bound(tri.vertex_angles.begin(),
-                         tri.vertex_angles.end(),
-                         r.theta_min / q,
-                         [](const QuantizedPoint& a, double t) { return a[0] < t; });
+    // Their angles are compared as the window was made from them (angles[v]: the
+    // quantized angle times q, monotone in it), so evidence on a border is inside.
+    const auto first = std::lower_bound(
+        tri.vertex_angles.begin(),
+        tri.vertex_angles.end(),
+        r.theta_min,
+        [q](const QuantizedPoint& a, double t) { return a[0] * q < t; });
     r.box_min = Eigen::Vector3f::Constant(std::numeric_limits<float>::max());
     r.box_max = Eigen::Vector3f::Constant(std::numeric_limits<float>::lowest());
-    for (auto it = first; it != tri.vertex_angles.end() && (*it)[0] <= r.theta_max / q;
+    for (auto it = first; it != tri.vertex_angles.end() && (*it)[0] * q <= r.theta_max;
          ++it) {
-      if ((*it)[1] < r.phi_min / q || (*it)[1] > r.phi_max / q)
+      if ((*it)[1] * q < r.phi_min || (*it)[1] * q > r.phi_max)
         continue;
       const auto v = static_cast<std::size_t>(it - tri.vertex_angles.begin());
       const Eigen::Vector3f x =
@@ -805,7 +851,8 @@ computeRegionsOfInterest(const SegmentationResult& result,
   for (const auto& r : candidates) {
     const bool fits = (p.max_regions == 0 || regions.size() < p.max_regions) &&
                       (p.max_points == 0 ||
-                       st.selected_points + r.estimated_points <= p.max_points) &&
+                       (r.estimated_points <= p.max_points &&
+                        st.selected_points <= p.max_points - r.estimated_points)) &&
                       (p.max_solid_angle == 0.0 ||
                        st.selected_solid_angle + r.solid_angle <= p.max_solid_angle);
     if (!fits) {
@@ -813,7 +860,10 @@ computeRegionsOfInterest(const SegmentationResult& result,
       continue;
     }
     regions.push_back(r);
-    st.selected_points += r.estimated_points;
+    const std::size_t most = std::numeric_limits<std::size_t>::max();
+    st.selected_points = r.estimated_points <= most - st.selected_points
+                             ? st.selected_points + r.estimated_points
+                             : most;
     st.selected_solid_angle += r.solid_angle;
   }
   st.selected = regions.size();

@@ -107,7 +107,7 @@ struct PCL_EXPORTS RegionOfInterestParameters {
   /** \brief Evidence is split into tiles of at most this size in each angle before
    * windows are made (a long diagonal edge becomes a staircase of small windows rather
    * than one large one); merged windows never exceed it either [rad].
-   * Valid: (0, pi]. */
+   * Valid: [1e-9, pi]. */
   double max_window_size = 0.05;
   /** \brief Windows smaller than this in an angle are widened to it, about their
    * centre [rad]. Valid: [0, max_window_size]. */
@@ -192,9 +192,11 @@ struct RegionOfInterest {
 
 /** \brief What computeRegionsOfInterest() found. */
 struct RegionOfInterestStats {
+  /** Vertices with evidence of each kind, counted before groups smaller than
+   * min_component_vertices are ignored. */
   std::size_t transition_vertices = 0;
-  std::size_t small_segment_vertices = 0;
-  std::size_t sparse_vertices = 0;
+  std::size_t small_segment_vertices = 0; ///< (as transition_vertices)
+  std::size_t sparse_vertices = 0;        ///< (as transition_vertices)
   std::size_t candidates = 0;        ///< windows after merging
   std::size_t already_fine = 0;      ///< candidates dropped by min_refinement
   std::size_t over_budget = 0;       ///< candidates left out by the budget
