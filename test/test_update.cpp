@@ -420,6 +420,87 @@ TEST(SelectiveSegmentationUpdate, ChangedSplitThresholdKeepsNoLeaf)
   expectSameResult(seg, ref);
 }
 
+// The result belongs to the input and indices it was made from: set again since,
+// update() segments the union of the current input and the new points from scratch
+// (it must not fold the new points into a mesh of other points).
+TEST(SelectiveSegmentationUpdate, InputOrIndicesSetAgainRunFromScratch)
+{
+  const auto scan = toXYZ(*selseg_test::cubeScan(5000, 11));
+  const std::size_t n = scan->size();
+  const auto old_part = slice(*scan, 0, n / 2);
+  const auto new_part = slice(*scan, n / 2, n);
+  std::vector<pcl::PointIndices> clusters;
+  {
+    // Indices set after extract(): every other old point, then the new ones.
+    Seg seg;
+    const double voxel = extractFirst(seg, old_part);
+    auto indices = pcl::make_shared<pcl::Indices>();
+    for (std::size_t i = 0; i < old_part->size(); i += 2)
+      indices->push_back(static_cast<pcl::index_t>(i));
+    seg.setIndices(indices);
+    ASSERT_TRUE(seg.update(*new_part, clusters));
+    EXPECT_FALSE(seg.getUpdateStatistics().incremental);
+    EXPECT_EQ(seg.getResult().counts.outside_indices,
+              old_part->size() - indices->size());
+    Seg ref;
+    auto all_indices = pcl::make_shared<pcl::Indices>(*indices);
+    for (std::size_t i = n / 2; i < n; ++i)
+      all_indices->push_back(static_cast<pcl::index_t>(i));
+    ref.setIndices(all_indices);
+    reference(scan, voxel, ref);
+    expectSameResult(seg, ref);
+    // The same indices again (another vector with the same contents): in place.
+    seg.setIndices(pcl::make_shared<pcl::Indices>(*all_indices));
+    ASSERT_TRUE(seg.update(Cloud(), clusters));
+    EXPECT_TRUE(seg.getUpdateStatistics().incremental);
+  }
+  {
+    // Another cloud of the same size.
+    const auto other = toXYZ(*selseg_test::cubeScan(5000, 12));
+    const auto other_part = slice(*other, 0, old_part->size());
+    Seg seg;
+    const double voxel = extractFirst(seg, old_part);
+    seg.setInputCloud(other_part);
+    ASSERT_TRUE(seg.update(*new_part, clusters));
+    EXPECT_FALSE(seg.getUpdateStatistics().incremental);
+    Seg ref;
+    reference(concat(*other_part, *new_part), voxel, ref);
+    expectSameResult(seg, ref);
+  }
+}
+
+// A failed update() leaves the input and indices as they were; with invalid
+// parameters nothing ran, the result is kept and a later update() works.
+TEST(SelectiveSegmentationUpdate, FailedUpdateLeavesTheInputAsItWas)
+{
+  const auto scan = toXYZ(*selseg_test::cubeScan(5000, 14));
+  const std::size_t n = scan->size();
+  const auto old_part = slice(*scan, 0, n / 2);
+  Seg seg;
+  const double voxel = extractFirst(seg, old_part);
+  const auto labels = seg.getResult().labels;
+  std::vector<pcl::PointIndices> clusters;
+  seg.setMaxMergeAngle(-1.0);
+  EXPECT_FALSE(seg.update(*slice(*scan, n / 2, n), clusters));
+  EXPECT_EQ(seg.getInputCloud(), old_part);
+  EXPECT_EQ(seg.getResult().labels, labels);
+  seg.setMaxMergeAngle(25.0 * M_PI / 180.0);
+  ASSERT_TRUE(seg.update(*slice(*scan, n / 2, n), clusters));
+  EXPECT_TRUE(seg.getUpdateStatistics().incremental);
+  Seg ref;
+  reference(scan, voxel, ref);
+  expectSameResult(seg, ref);
+  // A stage fails (an index beyond the union): the input and the indices are those
+  // before the call.
+  const auto input = seg.getInputCloud();
+  const auto bad = pcl::make_shared<pcl::Indices>(
+      pcl::Indices{0, 1, static_cast<pcl::index_t>(10 * n)});
+  seg.setIndices(bad);
+  EXPECT_FALSE(seg.update(*slice(*scan, 0, 10), clusters));
+  EXPECT_EQ(seg.getInputCloud(), input);
+  EXPECT_EQ(seg.getIndices(), bad);
+}
+
 TEST(SelectiveSegmentationUpdate, NeedsAResultToUpdate)
 {
   Seg seg;

@@ -189,9 +189,14 @@ public:
    * being updated is kept, so the result is that of extract() on the union with
    * setMinVoxelSize(getResult().min_voxel_size), bit for bit
    * (docs/incremental_update.md: what is recomputed, and when it runs from scratch).
+   * If the input cloud or the indices were set again since that run, the union of the
+   * current input and \a new_points is segmented from scratch. The input cloud must
+   * not be modified in place between the calls.
    * \param[in] new_points the points to add
    * \param[out] clusters as extract(), over the union
-   * \return as extract(); false also when there is no result to update. */
+   * \return as extract(); false also when there is no result to update. On failure
+   *         the input cloud and indices are those before the call; the result is
+   *         kept when nothing ran (invalid parameters), cleared when a stage failed. */
   bool update(const PointCloud& new_points, std::vector<pcl::PointIndices>& clusters);
 
   /** \brief What the last update() changed. */
@@ -257,6 +262,11 @@ protected:
   /** \brief Stages 4-5 and the clusters, after the mesh and its normals. */
   bool segmentMesh(std::vector<pcl::PointIndices>& clusters);
 
+  /** \brief Note the input and indices the mesh is made from (mesh_input_). */
+  void noteMeshInput();
+  /** \brief Whether the input and indices are those the mesh was made from. */
+  bool meshInputUnchanged() const;
+
   /** \brief update(): stages 1-3 for the new points only; false when they must run
    * from scratch (the state is then unchanged), or set \a failed (reported). */
   bool updateMesh(std::size_t first_new_point, bool& failed);
@@ -316,6 +326,11 @@ private:
   /** Parameters and sensor pose the current mesh and normals were computed with. */
   SelectiveSegmentationParameters mesh_params_;
   Eigen::Matrix4f mesh_pose_ = Eigen::Matrix4f::Zero();
+  /** The cloud and indices the current mesh was made from (noteMeshInput()): update()
+   * folds new points into the result in place only while they are still the input. */
+  typename PointCloud::ConstPtr mesh_input_;
+  bool mesh_all_points_ = true; ///< no indices were set
+  pcl::Indices mesh_indices_;   ///< a copy of the indices, when set
   UpdateStatistics update_stats_;
   /** update(): the previous octree's leaves and the positions changed since, for
    * buildOctree() to keep what did not change; empty otherwise. */

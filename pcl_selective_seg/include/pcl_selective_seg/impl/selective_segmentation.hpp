@@ -606,6 +606,7 @@ SelectiveSegmentation<PointT>::extract(std::vector<pcl::PointIndices>& clusters)
   clearOutputs();
   previous_leaves_ = typename Octree::PreviousLeaves(); // from scratch
   previous_merge_ = PreviousMerge();
+  mesh_input_.reset();
   pcl::StopWatch total;
   if (!initCompute()) {
     this->deinitCompute();
@@ -621,10 +622,33 @@ SelectiveSegmentation<PointT>::extract(std::vector<pcl::PointIndices>& clusters)
   result_.timings.normals = watch.getTimeSeconds();
   mesh_params_ = params_;
   mesh_pose_ = delaunay_.getSensorPose().matrix();
+  noteMeshInput();
   if (!segmentMesh(clusters))
     return false;
   result_.timings.total = total.getTimeSeconds();
   return true;
+}
+
+template <typename PointT>
+void
+SelectiveSegmentation<PointT>::noteMeshInput()
+{
+  mesh_input_ = input_;
+  mesh_all_points_ = this->fake_indices_ || !indices_;
+  if (mesh_all_points_)
+    pcl::Indices().swap(mesh_indices_);
+  else
+    mesh_indices_ = *indices_;
+}
+
+template <typename PointT>
+bool
+SelectiveSegmentation<PointT>::meshInputUnchanged() const
+{
+  if (!input_ || input_ != mesh_input_ || result_.labels.size() != input_->size())
+    return false;
+  const bool all_points = this->fake_indices_ || !indices_;
+  return all_points == mesh_all_points_ && (all_points || *indices_ == mesh_indices_);
 }
 
 template <typename PointT>

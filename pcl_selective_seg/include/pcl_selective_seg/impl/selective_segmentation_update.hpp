@@ -20,12 +20,24 @@ SelectiveSegmentation<PointT>::update(const PointCloud& new_points,
                                       std::vector<pcl::PointIndices>& clusters)
 {
   clusters.clear();
-  if (!input_ || result_.segments.empty() || result_.labels.size() != input_->size()) {
+  if (!input_ || !mesh_input_ || result_.segments.empty()) {
     PCL_ERROR("[pcl::selective_seg::%s::update] no result to update: call extract() "
               "first\n",
               getClassName().c_str());
     return false;
   }
+  // Invalid parameters: nothing changes (not even the input).
+  std::string why;
+  if (!params_.validate(&why)) {
+    PCL_ERROR(
+        "[pcl::selective_seg::%s::update] %s\n", getClassName().c_str(), why.c_str());
+    return false;
+  }
+  // In place only into the result of the current input and indices; else the union
+  // of the current input and the new points from scratch.
+  const bool in_place = meshInputUnchanged();
+  const auto previous_input = input_;
+  const auto previous_indices = this->fake_indices_ ? IndicesPtr() : indices_;
   pcl::StopWatch total;
   update_stats_ = UpdateStatistics();
   update_stats_.new_points = new_points.size();
@@ -56,14 +68,18 @@ SelectiveSegmentation<PointT>::update(const PointCloud& new_points,
     params_.min_voxel_size = result_.min_voxel_size;
   bool ok = false;
   bool failed = false;
-  if (updateMesh(first_new, failed)) {
+  if (in_place && updateMesh(first_new, failed)) {
     ok = segmentMesh(clusters);
     result_.timings.total = total.getTimeSeconds();
-  }
-  else if (!failed) {
+  } else if (!failed) {
     ok = extract(clusters); // no triangulation to update: from scratch on the union
   }
   params_ = saved;
+  if (!ok) { // the input and indices before the call
+    this->setInputCloud(previous_input);
+    if (previous_indices)
+      this->setIndices(previous_indices);
+  }
   return ok;
 }
 
@@ -143,6 +159,7 @@ SelectiveSegmentation<PointT>::updateMesh(std::size_t first_new_point, bool& fai
   }
   result_.timings.normals = watch.getTimeSeconds();
   mesh_params_ = params_;
+  noteMeshInput();
   return true;
 }
 
