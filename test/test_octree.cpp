@@ -1038,3 +1038,112 @@ main(int argc, char** argv)
   testing::InitGoogleTest(&argc, argv);
   return RUN_ALL_TESTS();
 }
+
+namespace {
+
+/** Points of every leaf of \a octree lying outside the leaf's voxel (beyond a
+ * thousandth of a voxel). */
+std::size_t
+pointsOutsideTheirVoxel(Octree& octree)
+{
+  const auto& cloud = *octree.getInputCloud();
+  const double tolerance = 1e-3 * octree.getResolution();
+  std::size_t outside = 0;
+  for (auto it = octree.leaf_depth_begin(); it != octree.leaf_depth_end(); ++it) {
+    pcl::Indices indices;
+    it.getLeafContainer().getPointIndices(indices);
+    Eigen::Vector3f lo, hi;
+    octree.getVoxelBounds(it, lo, hi);
+    for (const auto i : indices) {
+      const Eigen::Array3d p = cloud[i].getArray3fMap().cast<double>();
+      outside += (p < lo.cast<double>().array() - tolerance).any() ||
+                 (p > hi.cast<double>().array() + tolerance).any();
+    }
+  }
+  return outside;
+}
+
+/** \a n points spread over a cube of side \a extent at \a offset, normals tilted
+ * at random by up to about 45 deg. */
+Scene
+randomCube(std::size_t n, double extent, double offset = 0.0)
+{
+  Scene scene;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(0.0, 1.0), tilt(-0.8, 0.8);
+  for (std::size_t i = 0; i < n; ++i)
+    scene.add((Eigen::Vector3d::Constant(offset) +
+               extent * Eigen::Vector3d(u(rng), u(rng), u(rng)))
+                  .cast<float>(),
+              facingNormal(tilt(rng), tilt(rng)),
+              1.0);
+  return scene;
+}
+
+} // namespace
+
+// Voxels far below FLT_EPSILON (1.2e-7, which PCL's octree subtracts from the box's
+// sides when it counts voxels): the box must still hold every point in its voxel.
+TEST(OctreePointCloudNormalVariance, VoxelsBelowFloatEpsilonHoldTheirPoints)
+{
+  // 1e-9 voxels: PCL counts 119 voxels fewer than the extent holds, which drops a
+  // level below 1,074 and 2,100 voxels (not below 480).
+  for (const double extent : {1.074e-6, 2.1e-6, 4.8e-7}) {
+    const Scene scene = randomCube(3000, extent);
+    const auto octree = buildOctree(scene, 1e-9, kPaperThreshold);
+    EXPECT_GE(std::ldexp(octree->getResolution(), octree->getTreeDepth()), extent);
+    EXPECT_EQ(pointsOutsideTheirVoxel(*octree), 0u) << "extent " << extent;
+    std::size_t in_leaves = 0;
+    for (const AdaptiveLeaf& leaf : octree->getAdaptiveLeaves())
+      in_leaves += leaf.end - leaf.begin;
+    EXPECT_EQ(in_leaves, scene.cloud->size());
+  }
+  // A flat axis far from the origin, where FLT_EPSILON is below a double's ulp.
+  Scene flat;
+  for (int i = 0; i < 100; ++i)
+    flat.add(Eigen::Vector3f(1e-6f * static_cast<float>(i % 10), 1e12f, 1.0f),
+             facingNormal(0.0, 0.0),
+             1.0);
+  Octree octree(1e-8);
+  octree.setInputCloud(flat.cloud);
+  octree.setInputNormals(flat.normals, flat.areas);
+  if (octree.addPointsFromInputCloud()) { // or refused for its depth, with a message
+    EXPECT_LE(octree.getTreeDepth(), Octree::kMaxDepth);
+    EXPECT_EQ(pointsOutsideTheirVoxel(octree), 0u);
+  }
+}
+
+// Depth-first codes hold 21 levels: a deeper tree is refused, not split on codes cut
+// short.
+TEST(OctreePointCloudNormalVariance, TreesDeeperThan21LevelsAreRefused)
+{
+  const Scene scene = randomCube(500, 1.0);
+  Octree fine(1.0 / std::ldexp(1.0, 22)); // 2^22 voxels across
+  fine.setInputCloud(scene.cloud);
+  fine.setInputNormals(scene.normals, scene.areas);
+  EXPECT_FALSE(fine.addPointsAndComputeAdaptiveLeaves(kPaperThreshold, kMinPoints));
+  EXPECT_TRUE(fine.getAdaptiveLeaves().empty());
+  const auto ok = buildOctree(scene, 1.0 / std::ldexp(1.0, 20), kPaperThreshold);
+  EXPECT_LE(ok->getTreeDepth(), Octree::kMaxDepth);
+  EXPECT_FALSE(ok->getAdaptiveLeaves().empty());
+}
+
+// A second insertion into a tree that holds points keeps its box, as PCL's octree
+// does (redefining it re-anchored the existing leaves).
+TEST(OctreePointCloudNormalVariance, SecondInsertionKeepsTheBox)
+{
+  const Scene scene = randomCube(1000, 1.6, -0.3);
+  Octree octree(0.05);
+  octree.setInputCloud(scene.cloud);
+  octree.setInputNormals(scene.normals, scene.areas);
+  ASSERT_TRUE(octree.addPointsFromInputCloud());
+  const std::size_t leaves = octree.getLeafCount();
+  Eigen::Array<double, 6, 1> before, after;
+  octree.getBoundingBox(
+      before[0], before[1], before[2], before[3], before[4], before[5]);
+  ASSERT_TRUE(octree.addPointsFromInputCloud());
+  octree.getBoundingBox(after[0], after[1], after[2], after[3], after[4], after[5]);
+  EXPECT_TRUE((before == after).all());
+  EXPECT_EQ(octree.getLeafCount(), leaves);
+  EXPECT_EQ(pointsOutsideTheirVoxel(octree), 0u);
+}

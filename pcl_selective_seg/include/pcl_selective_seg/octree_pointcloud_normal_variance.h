@@ -130,9 +130,16 @@ public:
   void setNormalSpreadFrame(NormalSpreadFrame frame) { spread_frame_ = frame; }
   NormalSpreadFrame getNormalSpreadFrame() const { return spread_frame_; }
 
+  /** Deepest tree supported: a finest voxel's depth-first code interleaves 21 bits
+   * of each key in 64 bits. */
+  static constexpr unsigned kMaxDepth = 21;
+
   /** \brief Fit the bounding box to the valid points and insert them. Replaces
    * OctreePointCloud::addPointsFromInputCloud (which ignores normals and grows the
-   * box in insertion order). \return false when no point is valid. */
+   * box in insertion order); into a tree that already holds points they are inserted
+   * as PCL's octree does, its box kept or grown. \return false, with a PCL_ERROR when
+   * the points need more than kMaxDepth levels of the resolution, when no point is
+   * valid. */
   bool addPointsFromInputCloud();
 
   /** \brief Split from the root while sigma_theta or sigma_phi > max_std_dev [rad]
@@ -238,6 +245,8 @@ protected:
   /** \brief Inserts the valid points; with_angles: also orders them and computes their
    * normal angles for the next computeAdaptiveLeaves() (bulk insertion only). */
   bool insertPoints(bool with_angles);
+  /** \brief Whether the tree's depth is at most kMaxDepth; else a PCL_ERROR. */
+  bool checkDepth() const;
 
   /** \brief Frees the per-point normals, angles and weights (computeNormalAngles()),
    * needed only while computeAdaptiveLeaves() runs. */

@@ -108,6 +108,21 @@ OctreePointCloudNormalVariance<PointT>::isValidPoint(pcl::index_t index) const
 
 template <typename PointT>
 bool
+OctreePointCloudNormalVariance<PointT>::checkDepth() const
+{
+  if (this->octree_depth_ <= kMaxDepth)
+    return true;
+  PCL_ERROR("[pcl::selective_seg::OctreePointCloudNormalVariance] the points' extent "
+            "needs %u levels of %g voxels; at most %u are supported (a coarser "
+            "resolution is needed)\n",
+            static_cast<unsigned>(this->octree_depth_),
+            this->resolution_,
+            kMaxDepth);
+  return false;
+}
+
+template <typename PointT>
+bool
 OctreePointCloudNormalVariance<PointT>::addPointsFromInputCloud()
 {
   return insertPoints(false);
@@ -177,18 +192,58 @@ OctreePointCloudNormalVariance<PointT>::insertPoints(bool with_angles)
   std::vector<std::uint8_t>().swap(is_valid);
   if (valid.empty())
     return false;
+  if (!std::is_sorted(valid.begin(), valid.end()))
+    std::sort(valid.begin(), valid.end());
+  if (this->leaf_count_ != 0) {
+    // A tree that already holds points keeps its box: PCL's insertion, point by point
+    // (it grows the box as PCL's octree does).
+    for (const auto i : valid)
+      this->addPointIdx(i);
+    return checkDepth();
+  }
   // PCL's octree subtracts FLT_EPSILON (absolute) from each side of the box before
   // counting voxels: a narrower side (a scene smaller than 0.1 micrometre, or flat
   // along an axis with voxels under 12 micrometres) gave a negative count cast to an
-  // unsigned integer. Make every side at least 2 FLT_EPSILON wide.
-  hi = hi.max(lo + 2.0 * std::numeric_limits<float>::epsilon());
+  // unsigned integer. Make every side at least 2 FLT_EPSILON wide, and wide enough to
+  // differ from its low end (far from the origin FLT_EPSILON is below a double's ulp).
+  const Eigen::Array3d top = hi; // the points' largest coordinates
+  for (int a = 0; a < 3; ++a)
+    if (!(hi[a] - lo[a] >= 2.0 * std::numeric_limits<float>::epsilon()))
+      hi[a] = std::max(lo[a] + 2.0 * std::numeric_limits<float>::epsilon(),
+                       std::nextafter(std::nextafter(lo[a], HUGE_VAL), HUGE_VAL));
   // Pad the top so that no point sits exactly on the box's upper faces.
   hi += 0.01 * this->resolution_;
-  this->defineBoundingBox(lo.x(), lo.y(), lo.z(), hi.x(), hi.y(), hi.z());
+  // With voxels far below FLT_EPSILON, PCL's subtraction can leave the box short of
+  // the points, their keys beyond the tree's depth: then once more with the box
+  // widened by what PCL subtracts. The keys grow with the coordinates, so the largest
+  // point's decide (PCL's key formula); for voxels above about 12 micrometres the
+  // padding above covers the subtraction and the first box is always used.
+  unsigned depth = 0;
+  bool keys_fit = false;
+  for (int attempt = 0; attempt < 2 && !keys_fit; ++attempt) {
+    const double widen = attempt * std::numeric_limits<float>::epsilon();
+    this->defineBoundingBox(
+        lo.x(), lo.y(), lo.z(), hi.x() + widen, hi.y() + widen, hi.z() + widen);
+    depth = static_cast<unsigned>(this->octree_depth_);
+    if (!checkDepth())
+      return false;
+    Eigen::Array3d box_min, box_max;
+    this->getBoundingBox(
+        box_min.x(), box_min.y(), box_min.z(), box_max.x(), box_max.y(), box_max.z());
+    keys_fit = (((top - box_min) / this->resolution_) < std::ldexp(1.0, depth)).all();
+  }
+  if (!keys_fit) {
+    PCL_ERROR("[pcl::selective_seg::OctreePointCloudNormalVariance] the points' box "
+              "(%g x %g x %g) does not fit %u levels of %g voxels\n",
+              top.x() - lo.x(),
+              top.y() - lo.y(),
+              top.z() - lo.z(),
+              depth,
+              this->resolution_);
+    return false;
+  }
   // Finest voxels in depth-first (Morton) order, points by increasing index within
   // each (a stable radix sort of the codes of the points in increasing index order).
-  if (!std::is_sorted(valid.begin(), valid.end()))
-    std::sort(valid.begin(), valid.end());
   std::vector<std::pair<std::uint64_t, pcl::index_t>> order(valid.size());
   // The passes over the points below take microseconds on small clouds: less than
   // starting a team of threads.
@@ -202,20 +257,6 @@ OctreePointCloudNormalVariance<PointT>::insertPoints(bool with_angles)
     order[k] = {detail::mortonCode(key), valid[k]};
   }
   pcl::Indices().swap(valid);
-  const auto depth = static_cast<unsigned>(this->octree_depth_);
-  const bool keys_fit =
-      depth <= 21 && std::all_of(order.begin(), order.end(), [&](const auto& entry) {
-        return (entry.first >> (3 * depth)) == 0;
-      });
-  if (this->leaf_count_ != 0 || !keys_fit) {
-    // A tree that already holds points, or keys beyond the tree's depth (extents far
-    // below float epsilon defeat PCL's depth computation): PCL's insertion, point by
-    // point.
-    std::sort(order.begin(), order.end());
-    for (const auto& entry : order)
-      this->addPointIdx(entry.second);
-    return true;
-  }
   detail::radixSortByKey(order, static_cast<int>(3 * depth), num_threads_);
   // The leaves' indices, in one array that each leaf container views: with_angles, the
   // ordered points themselves (the sorted codes are the depth-first order of the tree:
@@ -513,7 +554,7 @@ OctreePointCloudNormalVariance<PointT>::computeAdaptiveLeaves(
     ordered_indices_ = pcl::Indices();
     releaseScratch();
   }
-  if (this->leaf_count_ == 0 || !this->root_node_) {
+  if (this->leaf_count_ == 0 || !this->root_node_ || !checkDepth()) {
     releaseScratch();
     return;
   }
