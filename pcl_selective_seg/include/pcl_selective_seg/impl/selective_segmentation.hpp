@@ -290,7 +290,9 @@ SelectiveSegmentation<PointT>::buildOctree()
     update_stats_.kept_leaves = octree_->getNumKeptLeaves();
   octree_->setInputNormals(typename Octree::NormalVectorsConstPtr(), vertex_areas_);
   if (!inserted)
-    return fail("extract", "no point with a normal to insert into the octree");
+    return fail("extract",
+                "the octree holds no point: no point has a normal, or the octree "
+                "refused the points' extent (reason above)");
 
   vertex_leaf_.assign(num_vertices, -1);
   const auto& leaves = octree_->getAdaptiveLeaves();
