@@ -188,7 +188,8 @@ outputsDistinct(const Options& opt)
       {"-mesh_ply", opt.mesh_ply},
       {"-mesh_vtk", opt.mesh_vtk},
       {"-leaves", opt.leaves},
-      {"-json", opt.json}};
+      {"-json", opt.json},
+      {"-roi_json", opt.roi_json}};
   for (std::size_t i = 0; i < outputs.size(); ++i) {
     if (outputs[i].second.empty())
       continue;

@@ -338,6 +338,28 @@ TEST_F(ToolFailure, OutputsThatCollideAreUsageErrors)
   EXPECT_TRUE(outputs().empty());
 }
 
+// -roi_json is an output like the others: it may name neither the input nor another
+// output (it replaced the scan with the regions, or one of two JSON files was lost).
+TEST_F(ToolFailure, RegionsFileThatCollidesIsAUsageError)
+{
+  const fs::path copy = dir / "in" / "scan.pcd";
+  fs::copy_file(scan, copy);
+  Outcome o =
+      run(shellQuoted(copy) + " -ignore_viewpoint -roi_json " + shellQuoted(copy));
+  EXPECT_EQ(o.code, 2) << o.messages;
+  EXPECT_NE(o.messages.find("-roi_json names the input"), std::string::npos)
+      << o.messages;
+  EXPECT_TRUE(readFile(copy) == readFile(scan)) << "the input was changed";
+  const fs::path json = dir / "out" / "x.json";
+  o = run(shellQuoted(copy) + " -ignore_viewpoint -json " + shellQuoted(json) +
+          " -roi_json " + shellQuoted(json));
+  EXPECT_EQ(o.code, 2) << o.messages;
+  EXPECT_NE(o.messages.find("-json and -roi_json name the same file"),
+            std::string::npos)
+      << o.messages;
+  EXPECT_TRUE(outputs().empty());
+}
+
 // PCL's PLY reader takes `obj_info num_cols N` / `num_rows N` (atoi) as the cloud's
 // layout and sizes its data by them; a value that does not match the vertex count made
 // it write past its data and abort on an assertion (exit 134). Found by fuzzing.
