@@ -168,16 +168,6 @@ parseVector(
   return true;
 }
 
-/** The same file, as far as the paths tell (symbolic links and "." resolved). */
-bool
-samePath(const std::string& a, const std::string& b)
-{
-  std::error_code ec_a, ec_b;
-  const auto ca = std::filesystem::weakly_canonical(a, ec_a);
-  const auto cb = std::filesystem::weakly_canonical(b, ec_b);
-  return !ec_a && !ec_b ? ca == cb : a == b;
-}
-
 /** Two outputs naming one file would silently keep only the last one; an output naming
  * the input would replace the scan. */
 bool
@@ -193,14 +183,15 @@ outputsDistinct(const Options& opt)
   for (std::size_t i = 0; i < outputs.size(); ++i) {
     if (outputs[i].second.empty())
       continue;
-    if (samePath(outputs[i].second, opt.input)) {
+    if (selseg_apps::samePath(outputs[i].second, opt.input)) {
       print_error("Option %s names the input file '%s': give another output name.\n",
                   outputs[i].first,
                   opt.input.c_str());
       return false;
     }
     for (std::size_t j = i + 1; j < outputs.size(); ++j)
-      if (!outputs[j].second.empty() && samePath(outputs[i].second, outputs[j].second)) {
+      if (!outputs[j].second.empty() &&
+          selseg_apps::samePath(outputs[i].second, outputs[j].second)) {
         print_error("Options %s and %s name the same file '%s': give each output its "
                     "own name.\n",
                     outputs[i].first,

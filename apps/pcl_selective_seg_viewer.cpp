@@ -49,6 +49,7 @@
 #include <utility>
 #include <vector>
 
+#include "outputs.h"
 #include "roi_json.h"
 #include "roi_options.h"
 #include "scan_io.h"
@@ -270,6 +271,16 @@ parseOptions(int argc, char** argv, Options& opt)
   }
   parse_argument(argc, argv, "-screenshot", opt.screenshot);
   parse_argument(argc, argv, "-roi_json", opt.roi_json);
+  // The picture would replace the scan or the regions file it shows.
+  for (const auto& [flag, read] : {std::make_pair("the input file", opt.input),
+                                   std::make_pair("the -roi_json file", opt.roi_json)})
+    if (!opt.screenshot.empty() && !read.empty() &&
+        selseg_apps::samePath(opt.screenshot, read)) {
+      print_error("Option -screenshot names %s '%s': give another output name.\n",
+                  flag,
+                  read.c_str());
+      return kUsageError;
+    }
   opt.roi = find_switch(argc, argv, "-roi");
   if (opt.roi && !opt.roi_json.empty()) {
     print_error("Give -roi or -roi_json, not both.\n");

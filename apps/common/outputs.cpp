@@ -217,6 +217,15 @@ jsonString(const std::string& s)
 
 } // namespace
 
+bool
+samePath(const std::string& a, const std::string& b)
+{
+  std::error_code ec_a, ec_b;
+  const auto ca = std::filesystem::weakly_canonical(a, ec_a);
+  const auto cb = std::filesystem::weakly_canonical(b, ec_b);
+  return !ec_a && !ec_b ? ca == cb : a == b;
+}
+
 OutputTransaction::~OutputTransaction()
 {
   if (!committed_)

@@ -18,6 +18,10 @@
 
 namespace selseg_apps {
 
+/** \brief The same file, as far as the paths tell (symbolic links and "." resolved):
+ * an output naming the input, or two outputs naming one file, are refused with it. */
+bool samePath(const std::string& a, const std::string& b);
+
 /** \brief Output files written under temporary names and renamed into place only when
  * all of them were written: a failed run leaves no partial or stale output behind. */
 class OutputTransaction {
