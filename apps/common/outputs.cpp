@@ -230,14 +230,28 @@ OutputTransaction::~OutputTransaction()
 {
   if (!committed_)
     for (const auto& f : files_)
-      std::remove(f.first.c_str());
+      std::remove(f.temporary.c_str());
 }
 
 std::string
 OutputTransaction::stage(const std::string& final_path)
 {
-  files_.emplace_back(final_path + ".tmp" + std::to_string(files_.size()), final_path);
-  return files_.back().first;
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  // The link's target, also when it does not exist yet (the output then creates it);
+  // a chain of links is followed to its end, a loop left to fail when written.
+  fs::path target = final_path;
+  for (int hops = 0; hops < 40 && fs::is_symlink(target, ec); ++hops) {
+    const fs::path next = fs::read_symlink(target, ec);
+    if (ec)
+      break;
+    target =
+        next.is_absolute() ? next : (target.parent_path() / next).lexically_normal();
+  }
+  files_.push_back({target.string() + ".tmp" + std::to_string(files_.size()),
+                    target.string(),
+                    final_path});
+  return files_.back().temporary;
 }
 
 bool
@@ -245,31 +259,40 @@ OutputTransaction::commit(std::string& error)
 {
   namespace fs = std::filesystem;
   std::error_code ec;
-  for (const auto& f : files_)
-    if (fs::is_directory(f.second, ec)) {
-      error = "cannot write '" + f.second + "': it is a folder; give a file name";
+  for (const auto& f : files_) {
+    const fs::file_status status = fs::status(f.target, ec);
+    if (fs::is_directory(status)) {
+      error = "cannot write '" + f.given + "': it is a folder; give a file name";
       return false;
     }
+    if (fs::exists(status) && !fs::is_regular_file(status)) {
+      error = "cannot write '" + f.given + "'" +
+              (f.target != f.given ? " (a link to '" + f.target + "')" : "") +
+              ": it is not a regular file (a device, a FIFO or a socket), which the "
+              "output would replace; give a file name";
+      return false;
+    }
+  }
   // Old files of the same names are kept as hard links until every rename succeeded,
   // so that a failure part way restores them: all outputs change, or none.
   std::vector<std::string> backups(files_.size());
   for (std::size_t i = 0; i < files_.size(); ++i) {
-    if (!fs::exists(files_[i].second, ec))
+    if (!fs::exists(files_[i].target, ec))
       continue;
-    const std::string backup = files_[i].first + ".old";
+    const std::string backup = files_[i].temporary + ".old";
     std::remove(backup.c_str());
-    if (::link(files_[i].second.c_str(), backup.c_str()) == 0)
+    if (::link(files_[i].target.c_str(), backup.c_str()) == 0)
       backups[i] = backup;
   }
   for (std::size_t i = 0; i < files_.size(); ++i)
-    if (std::rename(files_[i].first.c_str(), files_[i].second.c_str()) != 0) {
-      error = "cannot rename '" + files_[i].first + "' to '" + files_[i].second +
+    if (std::rename(files_[i].temporary.c_str(), files_[i].target.c_str()) != 0) {
+      error = "cannot rename '" + files_[i].temporary + "' to '" + files_[i].target +
               "': " + std::strerror(errno);
       for (std::size_t j = 0; j < i; ++j)
         if (backups[j].empty())
-          std::remove(files_[j].second.c_str());
+          std::remove(files_[j].target.c_str());
         else
-          std::rename(backups[j].c_str(), files_[j].second.c_str());
+          std::rename(backups[j].c_str(), files_[j].target.c_str());
       for (std::size_t j = i; j < files_.size(); ++j)
         if (!backups[j].empty())
           std::remove(backups[j].c_str());

@@ -32,15 +32,24 @@ public:
   /** \brief Removes the temporary files of an uncommitted transaction. */
   ~OutputTransaction();
 
-  /** \brief The temporary path to write \a final_path's content to. */
+  /** \brief The temporary path to write \a final_path's content to. A symbolic link
+   * is followed: the file is staged beside the link's target and replaces the target,
+   * so that the link stays a link. */
   std::string stage(const std::string& final_path);
 
-  /** \brief Rename every staged file to its final path.
+  /** \brief Rename every staged file to its final path. Refused, before anything is
+   * replaced, when a final path is an existing folder or other file that is not a
+   * regular one (a device, a FIFO, a socket): renaming would replace it.
    * \param[out] error the failure, naming the file */
   bool commit(std::string& error);
 
 private:
-  std::vector<std::pair<std::string, std::string>> files_; ///< (temporary, final)
+  struct Staged {
+    std::string temporary;
+    std::string target; ///< the final path, symbolic links followed
+    std::string given;  ///< the final path as given, for messages
+  };
+  std::vector<Staged> files_;
   bool committed_ = false;
 };
 

@@ -22,6 +22,7 @@
 #include <string>
 
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -294,6 +295,55 @@ TEST_F(ToolFailure, UnwritableLocationsLeaveNothing)
   EXPECT_EQ(readFile(dir / "out" / "summary.json"), "old");
   EXPECT_TRUE(fs::is_directory(dir / "out" / "folder.pcd"));
   EXPECT_EQ(outputs().size(), 3u);
+}
+
+// An output path that exists and is not a regular file was replaced by the renamed
+// temporary (a FIFO by a regular file, whose reader then waited for ever; as root, a
+// device such as /dev/null). It is refused with exit 1, as a folder is. A symbolic link
+// to a regular file stays a link: the file it names is replaced.
+TEST_F(ToolFailure, OutputsThatAreNotRegularFilesAreRefused)
+{
+  const fs::path out = dir / "out";
+  ASSERT_EQ(::mkfifo((out / "fifo.pcd").c_str(), 0600), 0);
+  fs::create_symlink("/dev/null", out / "null.json");
+  const std::string in = shellQuoted(scan) + " -ignore_viewpoint";
+  Outcome o = run(in + " -o " + shellQuoted(out / "fifo.pcd"));
+  EXPECT_EQ(o.code, 1) << o.messages;
+  EXPECT_NE(o.messages.find("not a regular file"), std::string::npos) << o.messages;
+  EXPECT_TRUE(fs::is_fifo(out / "fifo.pcd"));
+  o = run(in + " -json " + shellQuoted(out / "null.json"));
+  EXPECT_EQ(o.code, 1) << o.messages;
+  EXPECT_NE(o.messages.find("not a regular file"), std::string::npos) << o.messages;
+  EXPECT_TRUE(fs::is_symlink(out / "null.json"));
+  EXPECT_EQ(fs::read_symlink(out / "null.json"), "/dev/null");
+  EXPECT_EQ(outputs().size(), 2u); // no temporary left
+
+  // Links to a regular file in another folder (absolute), to a file not made yet
+  // (relative, dangling) and to a link: each stays a link, its target is written.
+  fs::create_directories(dir / "real");
+  writeFile(dir / "real" / "labels.pcd", "old labels");
+  fs::create_symlink(dir / "real" / "labels.pcd", out / "labels.pcd");
+  fs::create_symlink("new.json", out / "summary.json");
+  fs::create_symlink("summary.json", out / "again.json");
+  fs::remove(out / "fifo.pcd");
+  fs::remove(out / "null.json");
+  o = run(in + " -o " + shellQuoted(out / "labels.pcd") + " -json " +
+          shellQuoted(out / "again.json"));
+  ASSERT_EQ(o.code, 0) << o.messages;
+  EXPECT_TRUE(fs::is_symlink(out / "labels.pcd"));
+  EXPECT_TRUE(fs::is_symlink(out / "summary.json"));
+  EXPECT_TRUE(fs::is_symlink(out / "again.json"));
+  pcl::PointCloud<pcl::PointXYZL> labeled;
+  EXPECT_EQ(pcl::io::loadPCDFile((dir / "real" / "labels.pcd").string(), labeled), 0);
+  EXPECT_GT(labeled.size(), 0u);
+  EXPECT_NE(readFile(out / "new.json").find("\"segments\""), std::string::npos);
+  std::size_t in_real = 0;
+  for (const auto& e : fs::directory_iterator(dir / "real")) {
+    static_cast<void>(e);
+    ++in_real;
+  }
+  EXPECT_EQ(in_real, 1u); // no temporary left beside the target
+  EXPECT_EQ(outputs().size(), 4u);
 }
 
 // A full disk: the child may write at most N KiB per file (bash's ulimit -f, SIGXFSZ
