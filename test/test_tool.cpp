@@ -34,6 +34,7 @@
 
 #include "outputs.h"
 #include "process_memory.h"
+#include "roi_json.h"
 #include "segment_colors.h"
 
 namespace fs = std::filesystem;
@@ -520,6 +521,37 @@ TEST(SummaryJson, SegmentLinesKnownTextForAnyThreadCount)
       "\"area_m2\": 1000, \"normal\": [0.100000001, -0.5, 1]}\n  ]\n}\n";
   ASSERT_GE(text.size(), last.size());
   EXPECT_EQ(text.substr(text.size() - last.size()), last);
+}
+
+// A file name need not be UTF-8; the JSON files must be. Each ill-formed sequence of
+// the input's name becomes one U+FFFD (the longest start of a valid sequence, or one
+// byte), well-formed characters are kept, control characters escaped: the summary and
+// the regions file hold the same valid string.
+TEST(SummaryJson, InputNameIsValidUtf8)
+{
+  const std::string name = "a\xff"
+                           "b\xc3\xa9"
+                           "c\xe2\x82"
+                           "d\xed\xa0\x80"
+                           "e\xf0\x9f\x98\x80"
+                           "f\x01\xc3";
+  const std::string fffd = "\xef\xbf\xbd";
+  const std::string expected = "\"input\": \"a" + fffd + "b\xc3\xa9" + "c" + fffd +
+                               "d" + fffd + fffd + fffd + "e\xf0\x9f\x98\x80" +
+                               "f\\u0001" + fffd + "\",";
+  EXPECT_EQ(selseg_apps::jsonString("\xc0\xaf\xf5\x80\xf4\x90"),
+            "\"" + fffd + fffd + fffd + fffd + fffd + fffd + "\"");
+  selseg_apps::RunInfo info;
+  info.input = name;
+  const ScratchDir dir("selseg_json_utf8");
+  ASSERT_TRUE(selseg_apps::writeSummaryJson(
+      dir.file("summary.json"), info, pcl::selective_seg::SegmentationResult{}));
+  ASSERT_TRUE(
+      selseg_apps::writeRegionsJson(dir.file("regions.json"), name, {}, {}, {}));
+  for (const char* file : {"summary.json", "regions.json"}) {
+    const std::string text = fileBytes(dir.file(file));
+    EXPECT_NE(text.find(expected), std::string::npos) << file << ": " << text;
+  }
 }
 
 // The labeled cloud: PCL reads back the input's points, layout and viewpoint with the

@@ -197,25 +197,67 @@ faceColor(const SegmentedMesh& mesh, const std::vector<Rgb>& colors, std::size_t
              : triangleColor(mesh.labels[t], mesh.classes[t]);
 }
 
+/** The length of the well-formed UTF-8 sequence at \a s[i] (Unicode's table 3-7), or
+ * the negated length of its longest start that some well-formed sequence has (at least
+ * 1): what one U+FFFD replaces. */
+int
+utf8Sequence(const std::string& s, std::size_t i)
+{
+  const auto byte = [&](std::size_t k) {
+    return k < s.size() ? static_cast<unsigned char>(s[k]) : 0u;
+  };
+  const unsigned b = byte(i);
+  if (b < 0x80)
+    return 1;
+  int length = 0;
+  unsigned lo = 0x80, hi = 0xbf; // the range of the second byte
+  if (b >= 0xc2 && b <= 0xdf)
+    length = 2;
+  else if (b >= 0xe0 && b <= 0xef) {
+    length = 3;
+    lo = b == 0xe0 ? 0xa0 : 0x80;
+    hi = b == 0xed ? 0x9f : 0xbf;
+  } else if (b >= 0xf0 && b <= 0xf4) {
+    length = 4;
+    lo = b == 0xf0 ? 0x90 : 0x80;
+    hi = b == 0xf4 ? 0x8f : 0xbf;
+  } else
+    return -1;
+  for (int k = 1; k < length; ++k) {
+    const unsigned c = byte(i + static_cast<std::size_t>(k));
+    if (k == 1 ? c < lo || c > hi : c < 0x80 || c > 0xbf)
+      return -k;
+  }
+  return length;
+}
+
+} // namespace
+
 std::string
 jsonString(const std::string& s)
 {
   std::ostringstream out;
   out << '"';
-  for (const char c : s) {
+  for (std::size_t i = 0; i < s.size();) {
+    const char c = s[i];
+    const int length = utf8Sequence(s, i);
+    if (length < 0) {
+      out << "\xef\xbf\xbd"; // U+FFFD
+      i += static_cast<std::size_t>(-length);
+      continue;
+    }
     if (c == '"' || c == '\\')
       out << '\\' << c;
     else if (static_cast<unsigned char>(c) < 0x20)
       out << "\\u" << std::hex << std::setw(4) << std::setfill('0') << int(c)
           << std::dec;
     else
-      out << c;
+      out.write(s.data() + i, length);
+    i += static_cast<std::size_t>(length);
   }
   out << '"';
   return out.str();
 }
-
-} // namespace
 
 bool
 samePath(const std::string& a, const std::string& b)

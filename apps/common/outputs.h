@@ -22,6 +22,11 @@ namespace selseg_apps {
  * an output naming the input, or two outputs naming one file, are refused with it. */
 bool samePath(const std::string& a, const std::string& b);
 
+/** \brief \a s as a JSON string, in quotes: quotes, backslashes and control characters
+ * escaped, each ill-formed UTF-8 sequence (a file name's bytes need not be UTF-8)
+ * replaced by U+FFFD, so that the file is valid JSON. */
+std::string jsonString(const std::string& s);
+
 /** \brief Output files written under temporary names and renamed into place only when
  * all of them were written: a failed run leaves no partial or stale output behind. */
 class OutputTransaction {

@@ -12,6 +12,8 @@
 #include <iomanip>
 #include <sstream>
 
+#include "outputs.h"
+
 namespace selseg_apps {
 
 using pcl::selective_seg::RegionOfInterest;
@@ -77,14 +79,8 @@ writeRegionsJson(const std::string& path,
                  const std::vector<RegionOfInterest>& regions)
 {
   std::ofstream out(path);
-  out << std::setprecision(9) << "{\n  \"input\": \"";
-  for (const char c : input) {
-    if (c == '"' || c == '\\')
-      out << '\\';
-    if (static_cast<unsigned char>(c) >= 0x20)
-      out << c;
-  }
-  out << "\",\n  \"frames\": \"windows: sensor frame, theta = atan2(x, z), phi = "
+  out << std::setprecision(9) << "{\n  \"input\": " << jsonString(input)
+      << ",\n  \"frames\": \"windows: sensor frame, theta = atan2(x, z), phi = "
          "atan2(y, z) [rad]; boxes: cloud frame [m]\",\n"
       << "  \"budget\": {\"max_solid_angle_sr\": " << p.max_solid_angle
       << ", \"max_points\": " << p.max_points << ", \"max_regions\": " << p.max_regions
