@@ -21,7 +21,6 @@
 #include <pcl/console/print.h>
 #include <pcl/features/integral_image_normal.h>
 #include <pcl/features/normal_3d.h>
-#include <pcl/io/pcd_io.h>
 #include <pcl/search/kdtree.h>
 #include <pcl/segmentation/lccp_segmentation.h>
 #include <pcl/segmentation/organized_multi_plane_segmentation.h>
@@ -34,12 +33,18 @@
 #include <string>
 #include <vector>
 
+#include "outputs.h"
+#include "scan_io.h"
+#include "segmentation_options.h"
+
 using namespace pcl::console;
 using Cloud = pcl::PointCloud<pcl::PointXYZ>;
 using Labels = std::vector<std::uint32_t>;
 
 namespace {
 
+constexpr int kRuntimeError = 1;
+constexpr int kUsageError = 2;
 constexpr double kDeg = M_PI / 180.0;
 
 /** A method's labels (one per input point, 0 = none) and its run time. */
@@ -53,6 +58,9 @@ struct Method {
   std::string name;
   std::function<Run(const Cloud::ConstPtr&)> run;
   bool organized_only = false;
+  /** PCL's segmenters crash on a cloud without a finite point (they index the first
+   * valid one): such a cloud is reported as failed for them, not run. */
+  bool needs_finite_points = false;
 };
 
 Labels
@@ -223,9 +231,9 @@ methods()
           {"selective (rings 3)", selective(rings3)},
           {"selective (rings 2, vertex-mean eq. 8)", selective(robust2)},
           {"selective (rings 3, vertex-mean eq. 8)", selective(robust3)},
-          {"RegionGrowing", runRegionGrowing},
-          {"Supervoxel+LCCP", runLccp},
-          {"OrganizedMultiPlane", runMultiPlane, true}};
+          {"RegionGrowing", runRegionGrowing, false, true},
+          {"Supervoxel+LCCP", runLccp, false, true},
+          {"OrganizedMultiPlane", runMultiPlane, true, true}};
 }
 
 std::string
@@ -282,24 +290,102 @@ const char* kHeader =
 bool
 evaluate(const std::string& path, std::string& table)
 {
-  pcl::PointCloud<pcl::PointXYZL> labeled;
-  if (pcl::io::loadPCDFile(path, labeled) != 0 || labeled.empty()) {
-    print_error("Cannot read '%s' as a PCD with x y z label fields.\n", path.c_str());
+  auto cloud = pcl::make_shared<Cloud>();
+  Labels truth;
+  std::string error;
+  if (!selseg_apps::loadLabeledScan(path, *cloud, truth, error)) {
+    print_error("%s\n", error.c_str());
     return false;
   }
-  auto cloud = pcl::make_shared<Cloud>();
-  pcl::copyPointCloud(labeled, *cloud);
-  Labels truth(labeled.size());
-  for (std::size_t i = 0; i < labeled.size(); ++i)
-    truth[i] = std::isfinite(labeled[i].z) ? labeled[i].label : 0;
+  if (cloud->empty()) {
+    print_error("'%s' holds no point.\n", path.c_str());
+    return false;
+  }
+  std::size_t finite = 0;
+  for (std::size_t i = 0; i < cloud->size(); ++i) {
+    finite += pcl::isFinite((*cloud)[i]);
+    if (!std::isfinite((*cloud)[i].z))
+      truth[i] = 0;
+  }
+  if (finite == 0)
+    print_warn("'%s' has no finite point: PCL's methods are reported as failed.\n",
+               path.c_str());
   const std::string scene = path.substr(path.find_last_of('/') + 1);
   for (const auto& method : methods()) {
     if (method.organized_only && !cloud->isOrganized())
       continue;
-    const std::string line = row(scene, method.name, *cloud, truth, method.run(cloud));
+    const Run run =
+        method.needs_finite_points && finite == 0 ? Run{} : method.run(cloud);
+    const std::string line = row(scene, method.name, *cloud, truth, run);
     std::fputs(line.c_str(), stdout);
     std::fflush(stdout);
     table += line;
+  }
+  return true;
+}
+
+struct Options {
+  std::vector<std::string> inputs;
+  std::string output;
+};
+
+/** \return 0 on success, else the exit code. */
+int
+parseOptions(int argc, char** argv, Options& opt)
+{
+  if (!selseg_apps::optionsGivenOnce(
+          argc, argv, [](const std::string& arg) { return arg == "-o"; }))
+    return kUsageError;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "-o") {
+      if (++i >= argc || argv[i][0] == '\0') {
+        print_error("Option -o needs a file name (see -h).\n");
+        return kUsageError;
+      }
+      opt.output = argv[i];
+    } else if (arg.size() > 1 && arg[0] == '-') {
+      print_error("Unknown option '%s' (see -h).\n", arg.c_str());
+      return kUsageError;
+    } else if (arg.size() < 4 || arg.compare(arg.size() - 4, 4, ".pcd") != 0) {
+      print_error("'%s' is not a .pcd file: give PCD clouds with a label field (see "
+                  "-h).\n",
+                  arg.c_str());
+      return kUsageError;
+    } else
+      opt.inputs.push_back(arg);
+  }
+  if (opt.inputs.empty()) {
+    print_error("Give at least one CLOUD.pcd (see -h).\n");
+    return kUsageError;
+  }
+  for (const auto& input : opt.inputs)
+    if (!opt.output.empty() && selseg_apps::samePath(opt.output, input)) {
+      print_error("Option -o names the input file '%s': give another output name.\n",
+                  input.c_str());
+      return kUsageError;
+    }
+  return 0;
+}
+
+/** The table, written under a temporary name and renamed into place when complete. */
+bool
+writeTable(const std::string& path, const std::string& table)
+{
+  selseg_apps::OutputTransaction output;
+  std::ofstream out(output.stage(path), std::ios::binary);
+  out << table;
+  out.close();
+  std::string error;
+  if (!out) {
+    print_error("Cannot write '%s': check that the folder exists, is writable and has "
+                "free space.\n",
+                path.c_str());
+    return false;
+  }
+  if (!output.commit(error)) {
+    print_error("%s\n", error.c_str());
+    return false;
   }
   return true;
 }
@@ -314,25 +400,20 @@ main(int argc, char** argv)
                "Usage: %s CLOUD.pcd [CLOUD.pcd ...] [-o TABLE.md]\n"
                "  CLOUD.pcd  x y z label (ground truth; 0 = invalid), sensor at the "
                "origin looking along +z\n"
-               "  -o FILE    also write the markdown table to FILE\n",
+               "  -o FILE    also write the markdown table to FILE (only when every "
+               "cloud was read)\n",
                argv[0]);
-    return argc < 2 ? 2 : 0;
+    return argc < 2 ? kUsageError : 0;
   }
-  std::string output;
-  parse_argument(argc, argv, "-o", output);
+  Options opt;
+  if (const int code = parseOptions(argc, argv, opt))
+    return code;
   std::string table = kHeader;
   std::fputs(kHeader, stdout);
-  for (const int i : parse_file_extension_argument(argc, argv, ".pcd"))
-    if (argv[i] != output && !evaluate(argv[i], table))
-      return 1;
-  if (!output.empty()) {
-    const std::string tmp = output + ".tmp";
-    std::ofstream(tmp) << table;
-    if (std::rename(tmp.c_str(), output.c_str()) != 0) {
-      std::remove(tmp.c_str());
-      print_error("Cannot write '%s'.\n", output.c_str());
-      return 1;
-    }
-  }
+  for (const auto& input : opt.inputs)
+    if (!evaluate(input, table))
+      return kRuntimeError;
+  if (!opt.output.empty() && !writeTable(opt.output, table))
+    return kRuntimeError;
   return 0;
 }

@@ -454,11 +454,82 @@ extractXYZ(const std::string& path,
   return true;
 }
 
+/** The ground-truth "label" of every point of \a blob: one unsigned integer of 1, 2 or
+ * 4 bytes, or a signed one that is not negative. */
+bool
+extractLabels(const std::string& path,
+              const pcl::PCLPointCloud2& blob,
+              std::vector<std::uint32_t>& labels,
+              std::string& error)
+{
+  const int index = pcl::getFieldIndex(blob, "label");
+  if (index < 0) {
+    error = "cannot read '" + path + "': it has no \"label\" field (the ground truth)";
+    return false;
+  }
+  const pcl::PCLPointField& field = blob.fields[static_cast<std::size_t>(index)];
+  const auto type = field.datatype;
+  const bool is_signed = type == pcl::PCLPointField::INT8 ||
+                         type == pcl::PCLPointField::INT16 ||
+                         type == pcl::PCLPointField::INT32;
+  const bool is_unsigned = type == pcl::PCLPointField::UINT8 ||
+                           type == pcl::PCLPointField::UINT16 ||
+                           type == pcl::PCLPointField::UINT32;
+  if (!(is_signed || is_unsigned) || field.count != 1) {
+    error = "cannot read '" + path + "': its field label must be one integer, not " +
+            std::to_string(field.count) + " x " + typeName(type);
+    return false;
+  }
+  const std::size_t size = pcl::getFieldSize(type);
+  const std::size_t points = static_cast<std::size_t>(blob.width) * blob.height;
+  if (field.offset + size > blob.point_step ||
+      (points > 0 && blob.data.size() < points * blob.point_step)) {
+    error = "cannot read '" + path + "': its fields do not fit in its points (corrupt)";
+    return false;
+  }
+  labels.resize(points);
+  for (std::size_t i = 0; i < points; ++i) {
+    const std::uint8_t* at = blob.data.data() + i * blob.point_step + field.offset;
+    const auto read = [&](auto value) {
+      std::memcpy(&value, at, sizeof value);
+      return static_cast<std::int64_t>(value);
+    };
+    std::int64_t value = 0;
+    switch (type) {
+    case pcl::PCLPointField::INT8:
+      value = read(std::int8_t{});
+      break;
+    case pcl::PCLPointField::UINT8:
+      value = read(std::uint8_t{});
+      break;
+    case pcl::PCLPointField::INT16:
+      value = read(std::int16_t{});
+      break;
+    case pcl::PCLPointField::UINT16:
+      value = read(std::uint16_t{});
+      break;
+    case pcl::PCLPointField::INT32:
+      value = read(std::int32_t{});
+      break;
+    default:
+      value = read(std::uint32_t{});
+    }
+    if (value < 0) {
+      error = "cannot read '" + path + "': point " + std::to_string(i) +
+              " has a negative label";
+      return false;
+    }
+    labels[i] = static_cast<std::uint32_t>(value);
+  }
+  return true;
+}
+
 bool
 loadBinaryFormat(const std::string& path,
                  const std::string& ext,
                  pcl::PointCloud<pcl::PointXYZ>& cloud,
-                 std::string& error)
+                 std::string& error,
+                 std::vector<std::uint32_t>* labels = nullptr)
 {
   pcl::PCLPointCloud2 blob;
   Eigen::Vector4f origin = Eigen::Vector4f::Zero();
@@ -479,7 +550,8 @@ loadBinaryFormat(const std::string& path,
             ": check that the file exists, is readable and is not truncated";
     return false;
   }
-  if (!extractXYZ(path, blob, cloud, error))
+  if (!extractXYZ(path, blob, cloud, error) ||
+      (labels && !extractLabels(path, blob, *labels, error)))
     return false;
   cloud.sensor_origin_ = origin;
   cloud.sensor_orientation_ = orientation;
@@ -519,6 +591,26 @@ loadText(const std::string& path,
   return true;
 }
 
+/** load() on an existing regular file, its exceptions turned into messages. */
+template <typename Load>
+bool
+guardedLoad(const std::string& path, std::string& error, const Load& load)
+{
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    error = "cannot read '" + path + "': it does not exist or is not a regular file";
+    return false;
+  }
+  try {
+    return load();
+  } catch (const std::bad_alloc&) {
+    error = "cannot read '" + path + "': not enough memory for what it declares";
+  } catch (const std::exception& e) {
+    error = "cannot read '" + path + "': " + e.what();
+  }
+  return false;
+}
+
 } // namespace
 
 bool
@@ -528,30 +620,40 @@ loadScan(const std::string& path,
          std::string& error)
 {
   cloud.clear();
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) {
-    error = "cannot read '" + path + "': it does not exist or is not a regular file";
-    return false;
-  }
   const std::string ext = lowerExtension(path);
-  bool ok = false;
-  try {
-    ok = (ext == ".pcd" || ext == ".ply") ? loadBinaryFormat(path, ext, cloud, error)
-                                          : loadText(path, cloud, error);
-  } catch (const std::bad_alloc&) {
-    error = "cannot read '" + path + "': not enough memory for what it declares";
-    ok = false;
-  } catch (const std::exception& e) {
-    error = "cannot read '" + path + "': " + e.what();
-    ok = false;
-  }
-  if (!ok) {
+  if (!guardedLoad(path, error, [&] {
+        return (ext == ".pcd" || ext == ".ply")
+                   ? loadBinaryFormat(path, ext, cloud, error)
+                   : loadText(path, cloud, error);
+      })) {
     cloud.clear();
     return false;
   }
   if (unit_scale != 1.0)
     for (auto& p : cloud)
       p.getVector3fMap() *= static_cast<float>(unit_scale);
+  return true;
+}
+
+bool
+loadLabeledScan(const std::string& path,
+                pcl::PointCloud<pcl::PointXYZ>& cloud,
+                std::vector<std::uint32_t>& labels,
+                std::string& error)
+{
+  cloud.clear();
+  labels.clear();
+  if (lowerExtension(path) != ".pcd") {
+    error = "cannot read '" + path + "': give a .pcd file";
+    return false;
+  }
+  if (!guardedLoad(path, error, [&] {
+        return loadBinaryFormat(path, ".pcd", cloud, error, &labels);
+      })) {
+    cloud.clear();
+    labels.clear();
+    return false;
+  }
   return true;
 }
 

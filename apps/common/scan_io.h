@@ -9,7 +9,9 @@
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 
+#include <cstdint>
 #include <string>
+#include <vector>
 
 namespace selseg_apps {
 
@@ -28,5 +30,15 @@ bool loadScan(const std::string& path,
               double unit_scale,
               pcl::PointCloud<pcl::PointXYZ>& cloud,
               std::string& error);
+
+/** \brief Read a ground-truth scan: a PCD with x, y, z and a "label" field (one
+ * integer, not negative), checked as loadScan() checks a PCD.
+ * \param[out] cloud the points, in file order, with the file's layout and VIEWPOINT
+ * \param[out] labels the label of each point
+ * \param[out] error what is wrong with the file, when false */
+bool loadLabeledScan(const std::string& path,
+                     pcl::PointCloud<pcl::PointXYZ>& cloud,
+                     std::vector<std::uint32_t>& labels,
+                     std::string& error);
 
 } // namespace selseg_apps

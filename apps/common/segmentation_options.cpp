@@ -6,6 +6,9 @@
 
 #include "segmentation_options.h"
 
+#include <cctype>
+#include <set>
+
 namespace selseg_apps {
 namespace {
 
@@ -51,6 +54,28 @@ parseChoice(int argc,
 }
 
 } // namespace
+
+bool
+optionsGivenOnce(int argc,
+                 char** argv,
+                 const std::function<bool(const std::string&)>& takes_value)
+{
+  std::set<std::string> seen;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg.size() < 2 || arg[0] != '-' ||
+        !std::isalpha(static_cast<unsigned char>(arg[arg[1] == '-' ? 2 : 1])))
+      continue;
+    if (!seen.insert(arg).second) {
+      print_error("Option %s is given more than once: give it once (see -h).\n",
+                  arg.c_str());
+      return false;
+    }
+    if (takes_value(arg))
+      ++i;
+  }
+  return true;
+}
 
 const std::vector<std::string>&
 segmentationFlags()

@@ -12,6 +12,7 @@
 #include <pcl/console/print.h>
 
 #include <cmath>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,14 @@ parseNumber(int argc, char** argv, const char* flag, T& value)
   }
   return true;
 }
+
+/** \brief False, after printing an error, when an option is given more than once:
+ * pcl::console's parsers use its first value and ignore the others. Arguments that
+ * start with '-' and a letter are options; \a takes_value(option) tells whether the
+ * next argument is its value (then it is not an option, whatever it looks like). */
+bool optionsGivenOnce(int argc,
+                      char** argv,
+                      const std::function<bool(const std::string&)>& takes_value);
 
 /** \brief The flags of the segmentation parameters shared by the tools (each takes a
  * value). */

@@ -8,7 +8,8 @@
 // lying headers, wrong field types, unwritable folders, a full disk (a file size limit,
 // RLIMIT_FSIZE, in the child). Each gives a message saying what is wrong, exit code 1
 // (2 for usage errors), and no output: neither a partial file nor a changed old one.
-// Arguments: the tool's path, then the bundled scan.
+// pcl_selective_seg_compare is checked on broken clouds and command lines too.
+// Arguments: the tool's path, the bundled scan, then pcl_selective_seg_compare's path.
 
 #include <gtest/gtest.h>
 #include <pcl/io/pcd_io.h>
@@ -30,19 +31,22 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string tool; // NOLINT: set once in main()
-std::string scan; // NOLINT: set once in main()
+std::string tool;    // NOLINT: set once in main()
+std::string scan;    // NOLINT: set once in main()
+std::string compare; // NOLINT: set once in main(); pcl_selective_seg_compare
 
 struct Outcome {
   int code = -1;        ///< exit code, -1 when killed by a signal
   std::string messages; ///< stdout and stderr
 };
 
-/** Run the tool with \a args, optionally under a file size limit [KiB]. */
+/** Run \a program with \a args, optionally under a file size limit [KiB]. */
 Outcome
-run(const std::string& args, long file_size_limit_kib = -1)
+runProgram(const std::string& program,
+           const std::string& args,
+           long file_size_limit_kib = -1)
 {
-  std::string command = "'" + tool + "' " + args;
+  std::string command = "'" + program + "' " + args;
   if (file_size_limit_kib >= 0)
     command = "bash -c \"ulimit -f " + std::to_string(file_size_limit_kib) +
               "; trap '' XFSZ; exec " + command + "\"";
@@ -57,6 +61,13 @@ run(const std::string& args, long file_size_limit_kib = -1)
   const int status = pclose(pipe);
   o.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return o;
+}
+
+/** Run the tool with \a args, optionally under a file size limit [KiB]. */
+Outcome
+run(const std::string& args, long file_size_limit_kib = -1)
+{
+  return runProgram(tool, args, file_size_limit_kib);
 }
 
 std::string
@@ -505,6 +516,94 @@ TEST_F(ToolFailure, HeadersPclReadsDifferentlyAreRefused)
   EXPECT_LT(usage.ru_maxrss, 1L << 20) << "KiB"; // below 1 GiB
 }
 
+// pcl_selective_seg_compare reads its clouds with the tool's checked reader: a file
+// that is empty, noise or declares four billion points is a message and exit 1 (PCL's
+// reader crashed on the first two, and the third aborted on std::bad_alloc), and -o
+// writes nothing. A cloud without a finite point runs (PCL's segmenters crashed on
+// it): they are reported as failed.
+TEST_F(ToolFailure, CompareToolRejectsBrokenClouds)
+{
+  if (compare.empty() || !fs::exists(compare))
+    GTEST_SKIP() << "pcl_selective_seg_compare missing";
+  const fs::path in = dir / "in";
+  const std::string table = " -o " + shellQuoted(dir / "out" / "table.md");
+  std::string noise(5000, '\0');
+  for (std::size_t i = 0; i < noise.size(); ++i)
+    noise[i] = static_cast<char>((i * 2654435761u) >> 13);
+  writeFile(in / "noise.pcd", noise);
+  writeFile(in / "empty.pcd", "");
+  const std::string xyzl =
+      pcdHeader("x y z label", "4 4 4 4", "F F F U", "1 1 1 1", 4000000000u, "binary");
+  writeFile(in / "huge.pcd", xyzl + std::string(300 - xyzl.size() % 300, '\0'));
+  writeFile(in / "no_label.pcd",
+            pcdHeader("x y z", "4 4 4", "F F F", "1 1 1", 1, "ascii") + "0 0 1\n");
+  for (const char* name : {"noise.pcd", "empty.pcd", "huge.pcd", "no_label.pcd"}) {
+    const Outcome o = runProgram(compare, shellQuoted(in / name) + table);
+    EXPECT_EQ(o.code, 1) << name << ": " << o.messages;
+    EXPECT_NE(o.messages.find("cannot read '" + (in / name).string() + "'"),
+              std::string::npos)
+        << name << ": " << o.messages;
+    EXPECT_TRUE(outputs().empty()) << name;
+  }
+
+  std::ostringstream nan;
+  nan << pcdHeader("x y z label", "4 4 4 4", "F F F U", "1 1 1 1", 100, "ascii");
+  for (int i = 0; i < 100; ++i)
+    nan << "nan nan nan 0\n";
+  writeFile(in / "nan.pcd", nan.str());
+  const Outcome o = runProgram(compare, shellQuoted(in / "nan.pcd") + table);
+  EXPECT_EQ(o.code, 0) << o.messages;
+  const std::string text = readFile(dir / "out" / "table.md");
+  for (const char* method : {"RegionGrowing", "Supervoxel+LCCP"})
+    EXPECT_NE(text.find(std::string("| nan.pcd | ") + method + " | failed"),
+              std::string::npos)
+        << text;
+}
+
+// Its command line: unknown options, inputs that are not .pcd, -o twice or naming an
+// input are usage errors (they were ignored); a table that cannot be written
+// completely is exit 1 and no file (it was put in place unchecked).
+TEST_F(ToolFailure, CompareToolChecksItsCommandLineAndTable)
+{
+  if (compare.empty() || !fs::exists(compare))
+    GTEST_SKIP() << "pcl_selective_seg_compare missing";
+  const fs::path in = dir / "in";
+  std::ostringstream cloud;
+  cloud << pcdHeader("x y z label", "4 4 4 4", "F F F U", "1 1 1 1", 100, "ascii");
+  for (int i = 0; i < 100; ++i)
+    cloud << 0.01 * (i % 10) << " " << 0.01 * (i / 10) << " 1 1\n";
+  writeFile(in / "wall.pcd", cloud.str());
+  const std::string wall = shellQuoted(in / "wall.pcd");
+  const std::string table = shellQuoted(dir / "out" / "table.md");
+  const struct {
+    std::string args;
+    const char* message;
+  } usage[] = {
+      {wall + " -bogus", "Unknown option '-bogus'"},
+      {wall + " " + shellQuoted(in / "wall.xyz"), "is not a .pcd file"},
+      {wall + " -o " + table + " -o " + table, "-o is given more than once"},
+      {wall + " -o " + wall, "names the input"},
+      {"-o " + table, "at least one"},
+  };
+  for (const auto& u : usage) {
+    const Outcome o = runProgram(compare, u.args);
+    EXPECT_EQ(o.code, 2) << u.args << ": " << o.messages;
+    EXPECT_NE(o.messages.find(u.message), std::string::npos)
+        << u.args << ": " << o.messages;
+  }
+  EXPECT_TRUE(outputs().empty());
+  // Each cloud adds about 1.5 KB of rows: four are more than 1 KiB may hold.
+  const std::string four = wall + " " + wall + " " + wall + " " + wall;
+  Outcome o = runProgram(compare, four + " -o " + table, 1);
+  EXPECT_EQ(o.code, 1) << o.messages;
+  EXPECT_NE(o.messages.find("free space"), std::string::npos) << o.messages;
+  EXPECT_TRUE(outputs().empty());
+  o = runProgram(compare, four + " -o " + table);
+  EXPECT_EQ(o.code, 0) << o.messages;
+  EXPECT_GT(readFile(dir / "out" / "table.md").size(), 1024u);
+  EXPECT_EQ(outputs().size(), 1u);
+}
+
 int
 main(int argc, char** argv)
 {
@@ -513,5 +612,7 @@ main(int argc, char** argv)
     tool = argv[1];
     scan = argv[2];
   }
+  if (argc > 3)
+    compare = argv[3];
   return RUN_ALL_TESTS();
 }
