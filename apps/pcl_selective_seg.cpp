@@ -207,7 +207,9 @@ outputsDistinct(const Options& opt)
 int
 parseOptions(int argc, char** argv, Options& opt)
 {
-  if (!findInput(argc, argv, opt.input))
+  if (!findInput(argc, argv, opt.input) ||
+      !selseg_apps::optionsGivenOnce(
+          argc, argv, [](const std::string& arg) { return optionKind(arg) == 1; }))
     return kUsageError;
   parse_argument(argc, argv, "-o", opt.labels);
   parse_argument(argc, argv, "-mesh_ply", opt.mesh_ply);

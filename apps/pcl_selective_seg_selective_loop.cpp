@@ -141,6 +141,9 @@ parseOptions(int argc, char** argv, Options& opt)
       return false;
     }
   }
+  if (!selseg_apps::optionsGivenOnce(
+          argc, argv, [](const std::string&) { return true; }))
+    return false;
   parse_argument(argc, argv, "-out", opt.out);
   if (opt.out.empty()) {
     print_error("Give -out FOLDER.\n");

@@ -24,6 +24,7 @@
 #include <cstdio>
 #include <iterator>
 #include <map>
+#include <set>
 #include <string>
 
 using namespace pcl::console;
@@ -117,10 +118,17 @@ checkArguments(int argc, char** argv)
                                       "-hole_radius_deg",
                                       "-seed",
                                       "-o"};
+  std::set<std::string> seen;
   for (int i = 1; i < argc; i += 2) {
     const std::string arg = argv[i];
     if (std::find(std::begin(flags), std::end(flags), arg) == std::end(flags)) {
       print_error("Unknown argument '%s' (see %s -h).\n", argv[i], argv[0]);
+      return false;
+    }
+    // pcl::console's parsers would use the first value and ignore the others.
+    if (!seen.insert(arg).second) {
+      print_error("Option %s is given more than once: give it once (see -h).\n",
+                  argv[i]);
       return false;
     }
     if (i + 1 >= argc) {

@@ -252,7 +252,8 @@ parseInput(int argc, char** argv, Options& opt)
 int
 parseOptions(int argc, char** argv, Options& opt)
 {
-  if (!parseInput(argc, argv, opt))
+  if (!parseInput(argc, argv, opt) ||
+      !selseg_apps::optionsGivenOnce(argc, argv, isValueFlag))
     return kUsageError;
   auto& p = opt.params;
   if (!selseg_apps::parseNumber(argc, argv, "-unit_scale", opt.unit_scale) ||

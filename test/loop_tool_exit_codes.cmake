@@ -38,6 +38,9 @@ expect(2 "Unknown argument '-bogus'" -bogus 1)
 expect(2 "Missing value of '-out'" -out)
 expect(2 "Give -out FOLDER" -scenes cube)
 expect(2 "Unknown scene 'sofa'" -out ${BLOCKED}.d -scenes sofa)
+# A repeated option (the first value was used silently).
+expect(2 "Option -iterations is given more than once"
+  -out ${BLOCKED}/out -iterations 1 -iterations 2 -scenes cube)
 expect(1 "Cannot make the output folder '.*': .*writable folder"
   -out ${BLOCKED}/out -scenes cube)
 expect(1 "Cannot make the output folder" -out ${BLOCKED} -scenes cube)

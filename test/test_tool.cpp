@@ -208,6 +208,9 @@ TEST_F(Tool, BadOptionsAreUsageErrors)
   EXPECT_EQ(run(in + " -sensor_origin 1,2"), 2);
   EXPECT_EQ(run(in + " -unit_scale 0"), 2);
   EXPECT_EQ(run(in + " -threads -1"), 2);
+  // A repeated option: pcl::console's parsers used the first value silently.
+  EXPECT_EQ(run(in + " -o " + out("second.pcd")), 2);
+  EXPECT_EQ(run(in + " -split_deg 5 -split_deg 30"), 2);
   EXPECT_EQ(run(""), 2);
   EXPECT_EQ(run("-h"), 0);
   EXPECT_EQ(files(), 0u);

@@ -35,6 +35,9 @@ expect(2 ${INPUT} -normal_step -3)
 expect(2 ${INPUT} -normal_rings 0)
 expect(2 ${INPUT} -no_such_option)
 expect(2 ${INPUT} ${INPUT})
+# A repeated option (the first value was used silently).
+expect(2 ${INPUT} -split_deg 5 -split_deg 30)
+expect(2 ${INPUT} -ignore_viewpoint -ignore_viewpoint)
 expect(1 ${MISSING} -screenshot ${MISSING}.png)
 # A screenshot naming the input would replace the scan with a PNG: refused before the
 # scan is read (so, before any rendering), the copy unchanged.

@@ -1,0 +1,31 @@
+# ctest driver (cmake -P): pcl_selective_seg_simulate's exit codes and messages on usage
+# errors. None of these cases simulates a scan.
+#   -DSIMULATE=<the simulator tool>
+if(NOT DEFINED SIMULATE)
+  message(FATAL_ERROR "simulate_tool_exit_codes.cmake: -DSIMULATE=... is missing")
+endif()
+
+set(failures "")
+# expect(<exit code> <regex the error output must match, or ""> <argument>...)
+function(expect code pattern)
+  execute_process(COMMAND ${SIMULATE} ${ARGN}
+    RESULT_VARIABLE rc OUTPUT_QUIET ERROR_VARIABLE err)
+  if(NOT rc EQUAL code)
+    set(failures "${failures}\n  '${ARGN}': exit '${rc}', expected ${code} (${err})"
+      PARENT_SCOPE)
+  elseif(NOT pattern STREQUAL "" AND NOT err MATCHES "${pattern}")
+    set(failures "${failures}\n  '${ARGN}': message '${err}' does not match '${pattern}'"
+      PARENT_SCOPE)
+  endif()
+endfunction()
+
+expect(0 "" -h)
+expect(2 "Unknown argument '-bogus'" -bogus 1)
+expect(2 "needs a value > 0" -density 0)
+# A repeated option (the first value was used silently).
+expect(2 "Option -density is given more than once" -density 2 -density 3)
+expect(2 "Option -o is given more than once" -o a.pcd -o b.pcd)
+
+if(failures)
+  message(FATAL_ERROR "unexpected exit codes or messages:${failures}")
+endif()
