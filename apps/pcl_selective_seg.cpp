@@ -168,6 +168,27 @@ parseVector(
   return true;
 }
 
+/** A quaternion of norm 0 has no rotation to normalize to (Eigen returns it as it is,
+ * and a zero rotation matrix ends in a misleading runtime error), nor does one whose
+ * norm overflows. */
+bool
+orientationUsable(const std::vector<double>& q)
+{
+  if (q.empty())
+    return true;
+  double squares = 0.0;
+  for (const double x : q)
+    squares += x * x;
+  const double norm = std::sqrt(squares);
+  if (norm > 0.0 && std::isfinite(norm))
+    return true;
+  print_error("Option -sensor_orientation needs a quaternion W,X,Y,Z whose norm is "
+              "neither 0 nor too large to compute (got %g); it is normalized, so "
+              "1,0,0,0 is the identity.\n",
+              norm);
+  return false;
+}
+
 /** Two outputs naming one file would silently keep only the last one; an output naming
  * the input would replace the scan. */
 bool
@@ -223,7 +244,8 @@ parseOptions(int argc, char** argv, Options& opt)
   if (!selseg_apps::parseNumber(argc, argv, "-unit_scale", opt.unit_scale) ||
       !(opt.unit_scale > 0.0) ||
       !parseVector(argc, argv, "-sensor_origin", 3, opt.sensor_origin) ||
-      !parseVector(argc, argv, "-sensor_orientation", 4, opt.sensor_orientation)) {
+      !parseVector(argc, argv, "-sensor_orientation", 4, opt.sensor_orientation) ||
+      !orientationUsable(opt.sensor_orientation)) {
     if (!(opt.unit_scale > 0.0))
       print_error("Option -unit_scale needs a positive number.\n");
     return kUsageError;
@@ -253,8 +275,11 @@ sensorPose(const Options& opt,
     pose.translation() = Eigen::Vector3d(opt.sensor_origin.data()).cast<float>();
   if (!opt.sensor_orientation.empty()) {
     const auto& q = opt.sensor_orientation;
-    pose.linear() =
-        Eigen::Quaternionf(q[0], q[1], q[2], q[3]).normalized().toRotationMatrix();
+    // Normalized in double: the parts may not fit in a float before.
+    pose.linear() = Eigen::Quaterniond(q[0], q[1], q[2], q[3])
+                        .normalized()
+                        .cast<float>()
+                        .toRotationMatrix();
   }
   return true;
 }

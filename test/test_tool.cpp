@@ -211,6 +211,10 @@ TEST_F(Tool, BadOptionsAreUsageErrors)
   // A repeated option: pcl::console's parsers used the first value silently.
   EXPECT_EQ(run(in + " -o " + out("second.pcd")), 2);
   EXPECT_EQ(run(in + " -split_deg 5 -split_deg 30"), 2);
+  // A quaternion that cannot be normalized: 0 was taken as the identity, an overflowing
+  // norm ended in a runtime error.
+  EXPECT_EQ(run(in + " -sensor_orientation 0,0,0,0"), 2);
+  EXPECT_EQ(run(in + " -sensor_orientation 1e300,1e300,0,0"), 2);
   EXPECT_EQ(run(""), 2);
   EXPECT_EQ(run("-h"), 0);
   EXPECT_EQ(files(), 0u);
