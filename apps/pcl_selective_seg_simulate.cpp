@@ -167,6 +167,22 @@ parseOptions(int argc, char** argv, Options& opt)
     print_error("Option -density needs a value > 0.\n");
     return kUsageError;
   }
+  // makePaperScene() caps the rays at the simulator's limit, num_rays <= 1e8: a larger
+  // density would silently give the cap (and about a minute and 6 GB for it).
+  constexpr double kMaxRays = 1e8;
+  const double rays =
+      static_cast<double>(sim::makePaperScene(opt.scene).sensor.num_rays);
+  if (std::round(rays * opt.density) > kMaxRays) {
+    print_error(
+        "Option -density %.10g asks for %.10g rays on the %s scene; the simulator "
+        "casts at most %.0f: use -density %.2f or less.\n",
+        opt.density,
+        rays * opt.density,
+        scene.c_str(),
+        kMaxRays,
+        std::floor(kMaxRays / rays * 100.0) / 100.0);
+    return kUsageError;
+  }
   s.num_holes = static_cast<int>(holes);
   s.seed = static_cast<std::uint32_t>(seed);
   s.hole_radius = hole_radius_deg * kDeg;
