@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -168,6 +169,51 @@ pclHeaderKeyword(const std::string& word)
   return "";
 }
 
+/** The rows of an ASCII PCD from \a in (at the data): PCL reads a value it cannot
+ * parse as 0 (atof) and gives a row with too few values zeros or an exception, without
+ * failing the read, and ignores rows beyond the header's \a points. Each row must hold
+ * \a values_per_point numbers ("nan" in any case is NaN; strtod's forms, inf included,
+ * are numbers), and there must be at most \a points rows. Blank lines are skipped. */
+bool
+asciiRowsUsable(const std::string& path,
+                std::istream& in,
+                unsigned long long values_per_point,
+                unsigned long long points,
+                std::string& error)
+{
+  std::string line, word;
+  unsigned long long row = 0;
+  while (std::getline(in, line)) {
+    std::istringstream words(line);
+    unsigned long long values = 0;
+    bool numbers = true;
+    while (words >> word) {
+      ++values;
+      char* end = nullptr;
+      std::strtod(word.c_str(), &end);
+      const bool nan = word.size() == 3 && std::tolower(word[0]) == 'n' &&
+                       std::tolower(word[1]) == 'a' && std::tolower(word[2]) == 'n';
+      numbers = numbers && (nan || (end != word.c_str() && *end == '\0'));
+    }
+    if (values == 0)
+      continue;
+    if (++row > points) { // PCL stops at the header's count, with a warning
+      error = "cannot read '" + path + "' as PCD: it holds more rows than the " +
+              "header's " + std::to_string(points) + " points: the file is corrupt";
+      return false;
+    }
+    if (values != values_per_point || !numbers) {
+      error = "cannot read '" + path + "' as PCD: data row " + std::to_string(row) +
+              (numbers ? " holds " + std::to_string(values) + " values where the " +
+                             "header's fields take " + std::to_string(values_per_point)
+                       : " holds '" + line.substr(0, 40) + "', not only numbers") +
+              ": the file is corrupt";
+      return false;
+    }
+  }
+  return true;
+}
+
 /** The sizes a PCD header claims, read without PCL: PCL 1.13's readHeader already
  * allocates the data block the header claims, however large. */
 bool
@@ -301,10 +347,12 @@ pcdSizesPlausible(const std::string& path, std::string& error)
     return true;
   }
   // Binary data is exactly the points' bytes; text takes at least a byte per value.
-  return plausibleSize(path,
-                       claimed(data == "binary" ? bytes_per_point : values_per_point),
-                       data_bytes,
-                       error);
+  if (!plausibleSize(path,
+                     claimed(data == "binary" ? bytes_per_point : values_per_point),
+                     data_bytes,
+                     error))
+    return false;
+  return data != "ascii" || asciiRowsUsable(path, in, values_per_point, points, error);
 }
 
 /** PCL 1.13's PCDReader::read crashes on some malformed headers (no fields): check the

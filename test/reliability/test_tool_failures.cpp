@@ -224,6 +224,18 @@ TEST_F(ToolFailure, CorruptFilesAreRejected)
     writeFile(in / name, "");
     expectRejected(in / name, "'");
   }
+  // ASCII PCD rows that PCL reads as zeros or ignores (with only a warning): a row
+  // with too few values, a word, more rows than the header's points.
+  writeFile(in / "short_row.pcd", xyz + "0 0 1\n1 0\n1 1 1\n");
+  expectRejected(in / "short_row.pcd", "data row 2 holds 2 values");
+  writeFile(in / "word_row.pcd", xyz + "0 0 1\n1 zero 1\n1 1 1\n");
+  expectRejected(in / "word_row.pcd", "data row 2 holds '1 zero 1'");
+  writeFile(in / "extra_row.pcd", xyz + "0 0 1\n1 0 1\n\n1 1 1\n2 2 1\n");
+  expectRejected(in / "extra_row.pcd", "more rows than the header's 3 points");
+  writeFile(in / "nan_row.pcd", xyz + "0 0 1\n NaN\tnan 1 \r\n\n1 1 1\n");
+  // NaN in any case, tabs, a trailing carriage return and blank lines are PCL's too.
+  const Outcome nan_row = run(shellQuoted(in / "nan_row.pcd") + " -ignore_viewpoint");
+  EXPECT_EQ(nan_row.messages.find("data row"), std::string::npos) << nan_row.messages;
   // Text: a word among the numbers, a number beyond float's range.
   writeFile(in / "word.xyz", "0 0 1\n0.1 0 1\n0.1 zero 1\n");
   expectRejected(in / "word.xyz", "line 3");
