@@ -11,6 +11,8 @@
 // (coarse scan, regions of interest under a point budget, finer scans, update) are
 // segmented and scored. Writes OUT/table.md, OUT/<scene>.dat (gnuplot), the clouds and
 // windows for the pictures (OUT/<scene>_*.pcd, *.json) and OUT/<scene>_min_voxel.txt.
+// Every file is written under a temporary name and renamed into place only when the
+// whole run succeeded: a failed run leaves OUT as it was (a folder it made, removed).
 //
 // Exit codes: 0 = success, 1 = runtime error, 2 = usage error.
 
@@ -31,6 +33,7 @@
 #include <utility>
 #include <vector>
 
+#include "outputs.h"
 #include "roi_json.h"
 #include "roi_options.h"
 #include "segmentation_options.h"
@@ -242,12 +245,15 @@ tableRow(const std::string& scene,
   return line;
 }
 
+/** Writes \a cloud to \a outputs' temporary file for \a path. */
 bool
-savePcd(const std::string& path, const pcl::PointCloud<pcl::PointXYZL>& cloud)
+savePcd(selseg_apps::OutputTransaction& outputs,
+        const std::string& path,
+        const pcl::PointCloud<pcl::PointXYZL>& cloud)
 {
   bool ok = false;
   try {
-    ok = pcl::io::savePCDFileBinary(path, cloud) == 0;
+    ok = pcl::io::savePCDFileBinary(outputs.stage(path), cloud) == 0;
   } catch (const pcl::IOException&) {
   }
   if (!ok)
@@ -255,9 +261,25 @@ savePcd(const std::string& path, const pcl::PointCloud<pcl::PointXYZL>& cloud)
   return ok;
 }
 
-/** Run one scene; appends its rows to \a table. */
+/** The smallest fraction of \a points that is at least one point, rounded up to three
+ * digits. */
+double
+smallestFraction(std::size_t points)
+{
+  const double n = static_cast<double>(points);
+  const double unit = std::pow(10.0, std::floor(std::log10(1.0 / n)) - 2.0);
+  double f = std::ceil(1.0 / n / unit) * unit;
+  while (static_cast<std::size_t>(f * n) < 1)
+    f += unit;
+  return f;
+}
+
+/** Run one scene; appends its rows to \a table and stages its files in \a outputs. */
 bool
-runScene(const Options& opt, const std::string& name, std::string& table)
+runScene(const Options& opt,
+         const std::string& name,
+         std::string& table,
+         selseg_apps::OutputTransaction& outputs)
 {
   sim::PaperScene which;
   sim::parsePaperScene(name, which);
@@ -290,7 +312,7 @@ runScene(const Options& opt, const std::string& name, std::string& table)
       return false;
     }
     uniform.push_back(s);
-    if (f == 1.0 && !savePcd(base + "_dense.pcd", cloud))
+    if (f == 1.0 && !savePcd(outputs, base + "_dense.pcd", cloud))
       return false;
   }
   const std::size_t dense_points = uniform.back().points;
@@ -306,6 +328,16 @@ runScene(const Options& opt, const std::string& name, std::string& table)
   loop.progressive = opt.progressive == 1.0;
   loop.point_budget =
       static_cast<std::size_t>(opt.budget_fraction * static_cast<double>(dense_points));
+  if (loop.point_budget == 0) {
+    // Whether a fraction is too small depends on the scene's point count.
+    print_error("%s: -budget_fraction %g of the finest uniform scan's %zu points is a "
+                "budget of 0 points: give -budget_fraction %.3g or more.\n",
+                name.c_str(),
+                opt.budget_fraction,
+                dense_points,
+                smallestFraction(dense_points));
+    return false;
+  }
   std::vector<RegionOfInterest> scanned;
   std::vector<sim::ScanScore> rounds;
   bool files_ok = true;
@@ -342,13 +374,17 @@ runScene(const Options& opt, const std::string& name, std::string& table)
                  r.iteration,
                  100.0 * static_cast<double>(on_edge) / static_cast<double>(estimated));
     if (r.iteration == 0) {
-      files_ok = files_ok && savePcd(base + "_coarse.pcd", *r.cloud) &&
-                 selseg_apps::writeRegionsJson(
-                     base + "_coarse_rois.json", name, loop.regions, stats, regions);
+      files_ok =
+          files_ok && savePcd(outputs, base + "_coarse.pcd", *r.cloud) &&
+          selseg_apps::writeRegionsJson(outputs.stage(base + "_coarse_rois.json"),
+                                        name,
+                                        loop.regions,
+                                        stats,
+                                        regions);
     }
     scanned.insert(scanned.end(), regions.begin(), regions.end());
     if (regions.empty() || r.iteration == opt.iterations)
-      files_ok = files_ok && savePcd(base + "_refined.pcd", *r.cloud);
+      files_ok = files_ok && savePcd(outputs, base + "_refined.pcd", *r.cloud);
     print_info("%s: round %d, %zu points, boundary accuracy %.2f mm; evidence "
                "%zu/%zu/%zu vertices (transition/small/sparse), %zu candidate windows, "
                "%zu already fine, %zu over budget, %zu chosen (%zu points estimated)\n",
@@ -443,11 +479,13 @@ runScene(const Options& opt, const std::string& name, std::string& table)
   }
   pcl::selective_seg::RegionOfInterestStats all;
   all.selected = scanned.size();
-  files_ok = files_ok && selseg_apps::writeRegionsJson(
-                             base + "_windows.json", name, loop.regions, all, scanned);
+  files_ok =
+      files_ok &&
+      selseg_apps::writeRegionsJson(
+          outputs.stage(base + "_windows.json"), name, loop.regions, all, scanned);
   // Where the error is: every reference boundary point with its distance to the
   // nearest predicted boundary, for the finest uniform scan and the last round.
-  std::ofstream errors(base + "_boundary_errors.dat");
+  std::ofstream errors(outputs.stage(base + "_boundary_errors.dat"));
   errors << "# theta phi (rad) distance_dense distance_selective (m) depth_jump "
             "crease_angle (deg, nan: undetermined) in_window (0/1)\n";
   for (std::size_t i = 0; i < reference.points.size(); ++i) {
@@ -461,9 +499,9 @@ runScene(const Options& opt, const std::string& name, std::string& table)
   }
   errors.close();
   files_ok = files_ok && static_cast<bool>(errors);
-  std::ofstream voxel(base + "_min_voxel.txt");
+  std::ofstream voxel(outputs.stage(base + "_min_voxel.txt"));
   voxel << std::setprecision(9) << min_voxel << "\n";
-  std::ofstream dat(base + ".dat");
+  std::ofstream dat(outputs.stage(base + ".dat"));
   dat << "# " << name << ": fine step " << fine << " rad, coarse factor "
       << opt.coarse_factor << ", budget " << loop.point_budget << " points\n"
       << "# points seconds accuracy_mean_m accuracy_p90_m spurious_mean_m correct "
@@ -510,10 +548,31 @@ main(int argc, char** argv)
   opt.regions = sim::loopRegionParameters();
   if (!parseOptions(argc, argv, opt))
     return kUsageError;
-  // The output folder, made if missing, before any scan is simulated.
+  // The output folder, made if missing, before any scan is simulated. The folders this
+  // run makes are removed again (when empty) unless it succeeds.
+  namespace fs = std::filesystem;
   std::error_code ec;
-  std::filesystem::create_directories(opt.out, ec);
-  if (ec || !std::filesystem::is_directory(opt.out)) {
+  std::vector<fs::path> made; // innermost first
+  for (fs::path p = opt.out; !p.empty() && !fs::exists(fs::symlink_status(p, ec));
+       p = p.parent_path()) {
+    made.push_back(p);
+    if (p == p.parent_path())
+      break;
+  }
+  bool succeeded = false;
+  struct RemoveMade {
+    const std::vector<fs::path>& folders;
+    const bool& keep;
+    ~RemoveMade()
+    {
+      std::error_code ignored;
+      if (!keep)
+        for (const auto& f : folders)
+          fs::remove(f, ignored); // only an empty folder
+    }
+  } remove_made{made, succeeded};
+  fs::create_directories(opt.out, ec);
+  if (ec || !fs::is_directory(opt.out)) {
     print_error("Cannot make the output folder '%s'%s%s: give -out a writable folder.\n",
                 opt.out.c_str(),
                 ec ? ": " : "",
@@ -525,16 +584,24 @@ main(int argc, char** argv)
       "(mm) "
       "| p90 (mm) | spurious, mean (mm) | segments | correct/over/under/missed/noise "
       "| under-seg. error |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
+  // Declared after remove_made: its temporaries go before the folders.
+  selseg_apps::OutputTransaction outputs;
   for (const auto& scene : opt.scenes)
-    if (!runScene(opt, scene, table))
+    if (!runScene(opt, scene, table, outputs))
       return kRuntimeError;
-  std::ofstream out(opt.out + "/table.md");
+  std::ofstream out(outputs.stage(opt.out + "/table.md"));
   out << table;
   out.close();
   if (!out) {
     print_error("Cannot write '%s/table.md'.\n", opt.out.c_str());
     return kRuntimeError;
   }
+  std::string error;
+  if (!outputs.commit(error)) {
+    print_error("%s\n", error.c_str());
+    return kRuntimeError;
+  }
+  succeeded = true;
   print_info("%s", table.c_str());
   return 0;
 }
