@@ -13,8 +13,10 @@
 #include <pcl/point_types.h>
 #include <pcl/register_point_struct.h>
 
+#include <atomic>
 #include <cerrno>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -197,6 +199,83 @@ faceColor(const SegmentedMesh& mesh, const std::vector<Rgb>& colors, std::size_t
              : triangleColor(mesh.labels[t], mesh.classes[t]);
 }
 
+// The temporaries a signal removes (OutputTransaction): a fixed array of C strings, so
+// that the handler neither allocates nor locks. An entry's state is kFree, kFilling
+// (its path being written) or kStaged; the handler reads only kStaged ones.
+constexpr int kFree = 0, kFilling = 1, kStaged = 2;
+constexpr std::size_t kSignalSlots = 128;
+constexpr std::size_t kSignalPathMax = 4096; // with its terminating 0
+constexpr char kBackupSuffix[] = ".old";     // commit()'s hard links to old files
+static_assert(std::atomic<int>::is_always_lock_free, "the handler reads the states");
+
+struct SignalSlot {
+  std::atomic<int> state{kFree};
+  char path[kSignalPathMax];
+};
+SignalSlot signal_slots[kSignalSlots]; // NOLINT: shared with the signal handler
+
+/** Removes every staged temporary and its backup link, then raises \a sig again with
+ * the default action. Async-signal-safe: unlink(), signal() and raise() only. */
+extern "C" void
+removeTemporariesAndRaise(int sig)
+{
+  for (auto& slot : signal_slots) {
+    if (slot.state.load(std::memory_order_acquire) != kStaged)
+      continue;
+    ::unlink(slot.path);
+    char backup[kSignalPathMax + sizeof kBackupSuffix];
+    std::size_t n = 0;
+    for (; slot.path[n] != '\0'; ++n)
+      backup[n] = slot.path[n];
+    for (const char c : kBackupSuffix) // with its terminating 0
+      backup[n++] = c;
+    ::unlink(backup);
+  }
+  std::signal(sig, SIG_DFL);
+  std::raise(sig); // blocked in the handler: delivered when it returns
+}
+
+/** Installs removeTemporariesAndRaise() for SIGTERM, SIGINT and SIGHUP where the action
+ * is the default one, once. */
+void
+installSignalHandler()
+{
+  static bool installed = false;
+  if (installed)
+    return;
+  installed = true;
+  const int signals[] = {SIGTERM, SIGINT, SIGHUP};
+  struct sigaction action {};
+  action.sa_handler = removeTemporariesAndRaise;
+  sigemptyset(&action.sa_mask);
+  for (const int sig : signals) // one at a time: no second signal during the removal
+    sigaddset(&action.sa_mask, sig);
+  for (const int sig : signals) {
+    struct sigaction old {};
+    if (::sigaction(sig, nullptr, &old) == 0 && !(old.sa_flags & SA_SIGINFO) &&
+        old.sa_handler == SIG_DFL)
+      ::sigaction(sig, &action, nullptr);
+  }
+}
+
+/** An entry of the signal handler holding \a path, or -1 when none is free or the path
+ * is too long. */
+int
+takeSignalSlot(const std::string& path)
+{
+  if (path.size() + 1 > kSignalPathMax)
+    return -1;
+  for (std::size_t i = 0; i < kSignalSlots; ++i) {
+    int expected = kFree;
+    if (!signal_slots[i].state.compare_exchange_strong(expected, kFilling))
+      continue;
+    std::memcpy(signal_slots[i].path, path.c_str(), path.size() + 1);
+    signal_slots[i].state.store(kStaged, std::memory_order_release);
+    return static_cast<int>(i);
+  }
+  return -1;
+}
+
 /** The length of the well-formed UTF-8 sequence at \a s[i] (Unicode's table 3-7), or
  * the negated length of its longest start that some well-formed sequence has (at least
  * 1): what one U+FFFD replaces. */
@@ -273,6 +352,17 @@ OutputTransaction::~OutputTransaction()
   if (!committed_)
     for (const auto& f : files_)
       std::remove(f.temporary.c_str());
+  releaseSignalSlots();
+}
+
+void
+OutputTransaction::releaseSignalSlots()
+{
+  for (auto& f : files_)
+    if (f.signal_slot >= 0) {
+      signal_slots[f.signal_slot].state.store(kFree, std::memory_order_release);
+      f.signal_slot = -1;
+    }
 }
 
 std::string
@@ -290,9 +380,11 @@ OutputTransaction::stage(const std::string& final_path)
     target =
         next.is_absolute() ? next : (target.parent_path() / next).lexically_normal();
   }
-  files_.push_back({target.string() + ".tmp" + std::to_string(files_.size()),
-                    target.string(),
-                    final_path});
+  const std::string temporary =
+      target.string() + ".tmp" + std::to_string(files_.size());
+  // In the signal handler's array before the caller opens the file.
+  installSignalHandler();
+  files_.push_back({temporary, target.string(), final_path, takeSignalSlot(temporary)});
   return files_.back().temporary;
 }
 
@@ -321,7 +413,7 @@ OutputTransaction::commit(std::string& error)
   for (std::size_t i = 0; i < files_.size(); ++i) {
     if (!fs::exists(files_[i].target, ec))
       continue;
-    const std::string backup = files_[i].temporary + ".old";
+    const std::string backup = files_[i].temporary + kBackupSuffix;
     std::remove(backup.c_str());
     if (::link(files_[i].target.c_str(), backup.c_str()) == 0)
       backups[i] = backup;
@@ -344,6 +436,7 @@ OutputTransaction::commit(std::string& error)
     if (!b.empty())
       std::remove(b.c_str());
   committed_ = true;
+  releaseSignalSlots();
   return true;
 }
 

@@ -28,7 +28,16 @@ bool samePath(const std::string& a, const std::string& b);
 std::string jsonString(const std::string& s);
 
 /** \brief Output files written under temporary names and renamed into place only when
- * all of them were written: a failed run leaves no partial or stale output behind. */
+ * all of them were written: a failed run leaves no partial or stale output behind.
+ *
+ * A run ended by SIGTERM, SIGINT or SIGHUP leaves none either: the first stage()
+ * installs a handler for each of them whose action is the default one (one that is
+ * ignored stays ignored) that removes the staged temporaries of every transaction not
+ * yet committed or destroyed, then re-raises the signal with the default action (the
+ * exit status stays 128 + the signal's number). The handler reads the paths from a
+ * fixed array of C strings, filled before the files are opened: it allocates nothing
+ * and takes no lock. A path of 4 KiB or more, or beyond the array's 128 entries, is
+ * not covered. */
 class OutputTransaction {
 public:
   OutputTransaction() = default;
@@ -53,7 +62,10 @@ private:
     std::string temporary;
     std::string target; ///< the final path, symbolic links followed
     std::string given;  ///< the final path as given, for messages
+    int signal_slot;    ///< the signal handler's entry of the temporary, or -1
   };
+  /** Take the temporaries out of the signal handler's reach. */
+  void releaseSignalSlots();
   std::vector<Staged> files_;
   bool committed_ = false;
 };

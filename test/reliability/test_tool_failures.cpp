@@ -8,13 +8,17 @@
 // lying headers, wrong field types, unwritable folders, a full disk (a file size limit,
 // RLIMIT_FSIZE, in the child). Each gives a message saying what is wrong, exit code 1
 // (2 for usage errors), and no output: neither a partial file nor a changed old one.
-// pcl_selective_seg_compare is checked on broken clouds and command lines too.
-// Arguments: the tool's path, the bundled scan, then pcl_selective_seg_compare's path.
+// pcl_selective_seg_compare is checked on broken clouds and command lines too. A run
+// ended by a signal while it writes leaves no temporary file.
+// Arguments: the tool's path, the bundled scan, pcl_selective_seg_compare's path, then
+// pcl_selective_seg_simulate's path.
 
 #include <gtest/gtest.h>
 #include <pcl/io/pcd_io.h>
 #include <pcl/io/ply_io.h>
 
+#include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -22,6 +26,7 @@
 #include <sstream>
 #include <string>
 
+#include <fcntl.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -34,6 +39,7 @@ namespace {
 std::string tool;    // NOLINT: set once in main()
 std::string scan;    // NOLINT: set once in main()
 std::string compare; // NOLINT: set once in main(); pcl_selective_seg_compare
+std::string simulate; // NOLINT: set once in main(); pcl_selective_seg_simulate
 
 struct Outcome {
   int code = -1;        ///< exit code, -1 when killed by a signal
@@ -616,6 +622,86 @@ TEST_F(ToolFailure, CompareToolChecksItsCommandLineAndTable)
   EXPECT_EQ(outputs().size(), 1u);
 }
 
+// A run ended by SIGTERM, SIGINT or SIGHUP while it wrote its outputs left its
+// temporaries (OUT.tmpN, 1.4 MB seen). The tool now removes them and ends by the same
+// signal (exit status 128 + its number). Each signal is sent once a temporary exists;
+// a run that ends before one is seen is not counted, and the test is skipped when no
+// run was caught writing.
+TEST_F(ToolFailure, SignalsLeaveNoTemporaries)
+{
+  if (simulate.empty() || !fs::exists(simulate))
+    GTEST_SKIP() << "pcl_selective_seg_simulate missing";
+  // About a million points: the outputs take a few hundred milliseconds to write.
+  const fs::path big = dir / "in" / "door.pcd";
+  const Outcome made =
+      runProgram(simulate, "-scene door -density 20 -o " + shellQuoted(big));
+  ASSERT_EQ(made.code, 0) << made.messages;
+  const fs::path out = dir / "out";
+  const std::string labels = (out / "labels.pcd").string();
+  const std::string mesh = (out / "mesh.ply").string();
+  const auto temporaryExists = [&] {
+    for (const auto& e : fs::directory_iterator(out))
+      if (e.path().filename().string().find(".tmp") != std::string::npos)
+        return true;
+    return false;
+  };
+  int caught = 0;
+  for (const int sig : {SIGTERM, SIGINT, SIGHUP}) {
+    for (const auto& e : fs::directory_iterator(out))
+      fs::remove_all(e.path());
+    const pid_t pid = ::fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+      // The default actions, whatever this process inherited (a shell's background
+      // job ignores SIGINT).
+      for (const int s : {SIGTERM, SIGINT, SIGHUP})
+        std::signal(s, SIG_DFL);
+      const int null = ::open("/dev/null", O_WRONLY);
+      ::dup2(null, 1);
+      ::dup2(null, 2);
+      const char* argv[] = {tool.c_str(),
+                            big.c_str(),
+                            "-o",
+                            labels.c_str(),
+                            "-mesh_ply",
+                            mesh.c_str(),
+                            nullptr};
+      ::execv(tool.c_str(), const_cast<char* const*>(argv));
+      ::_exit(127);
+    }
+    int status = 0;
+    bool ended = false, seen = false;
+    const auto start = std::chrono::steady_clock::now();
+    while (!ended && !seen) {
+      ended = ::waitpid(pid, &status, WNOHANG) == pid;
+      seen = !ended && temporaryExists();
+      if (!ended && !seen) {
+        if (std::chrono::steady_clock::now() - start > std::chrono::seconds(120)) {
+          ::kill(pid, SIGKILL);
+          ::waitpid(pid, &status, 0);
+          FAIL() << "the tool ran for more than 120 s";
+        }
+        ::usleep(500);
+      }
+    }
+    if (seen) {
+      ::kill(pid, sig);
+      ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+    }
+    if (!seen || (WIFEXITED(status) && WEXITSTATUS(status) == 0))
+      continue; // it ended before the signal: nothing to check
+    ++caught;
+    EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == sig)
+        << "signal " << sig << ": status " << status << ", expected exit status "
+        << 128 + sig;
+    EXPECT_TRUE(outputs().empty())
+        << "signal " << sig << ": " << outputs().size() << " files left, the first "
+        << (outputs().empty() ? "" : outputs()[0]);
+  }
+  if (caught == 0)
+    GTEST_SKIP() << "every run ended before a temporary file was seen";
+}
+
 int
 main(int argc, char** argv)
 {
@@ -626,5 +712,7 @@ main(int argc, char** argv)
   }
   if (argc > 3)
     compare = argv[3];
+  if (argc > 4)
+    simulate = argv[4];
   return RUN_ALL_TESTS();
 }
