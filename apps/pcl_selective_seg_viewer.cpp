@@ -721,7 +721,17 @@ SegmentationViewer::spin()
 bool
 SegmentationViewer::saveScreenshot(const std::string& path)
 {
-  if (!std::ofstream(path, std::ios::binary)) {
+  // Written to a temporary and renamed into place: a failed run leaves no partial
+  // picture, and a path that is not a regular file (a folder, a FIFO, a device) is
+  // refused before anything is rendered.
+  selseg_apps::OutputTransaction output;
+  const std::string temporary = output.stage(path);
+  std::string error;
+  if (!output.check(error)) {
+    print_error("%s\n", error.c_str());
+    return false;
+  }
+  if (!std::ofstream(temporary, std::ios::binary)) {
     print_error("Cannot write '%s': check that the folder exists and is writable.\n",
                 path.c_str());
     return false;
@@ -735,11 +745,15 @@ SegmentationViewer::saveScreenshot(const std::string& path)
   grab->Update();
   vtkNew<vtkPNGWriter> writer;
   writer->SetCompressionLevel(9);
-  writer->SetFileName(path.c_str());
+  writer->SetFileName(temporary.c_str());
   writer->SetInputConnection(grab->GetOutputPort());
   writer->Write();
   if (writer->GetErrorCode() != 0) {
     print_error("Cannot write the PNG '%s' (disk full?).\n", path.c_str());
+    return false;
+  }
+  if (!output.commit(error)) {
+    print_error("%s\n", error.c_str());
     return false;
   }
   print_info("Wrote '%s' [%d x %d]\n",

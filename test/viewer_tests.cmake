@@ -8,14 +8,18 @@ endif()
 
 set(SELSEG_VIEWER_SCAN ${PROJECT_SOURCE_DIR}/data/table_scene_mug_stereo_textured.pcd)
 
+# With xvfb-run, viewer_exit_codes also checks the screenshot's failures under it.
+find_program(XVFB_RUN xvfb-run)
 add_test(NAME viewer_exit_codes
   COMMAND ${CMAKE_COMMAND}
     -DVIEWER=$<TARGET_FILE:pcl_selective_seg_viewer>
     -DINPUT=${SELSEG_VIEWER_SCAN}
     -DMISSING=${CMAKE_CURRENT_BINARY_DIR}/no_such_scan.pcd
+    -DXVFB_RUN=${XVFB_RUN}
     -P ${CMAKE_CURRENT_LIST_DIR}/viewer_exit_codes.cmake)
+# One virtual X server at a time (viewer_screenshot_*).
+set_tests_properties(viewer_exit_codes PROPERTIES RESOURCE_LOCK xvfb TIMEOUT 300)
 
-find_program(XVFB_RUN xvfb-run)
 if(NOT XVFB_RUN)
   message(STATUS "xvfb-run not found (apt-get install xvfb xauth libgl1-mesa-dri): "
     "the viewer's screenshot tests are skipped")

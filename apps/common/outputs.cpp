@@ -389,7 +389,7 @@ OutputTransaction::stage(const std::string& final_path)
 }
 
 bool
-OutputTransaction::commit(std::string& error)
+OutputTransaction::check(std::string& error) const
 {
   namespace fs = std::filesystem;
   std::error_code ec;
@@ -407,6 +407,16 @@ OutputTransaction::commit(std::string& error)
       return false;
     }
   }
+  return true;
+}
+
+bool
+OutputTransaction::commit(std::string& error)
+{
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!check(error))
+    return false;
   // Old files of the same names are kept as hard links until every rename succeeded,
   // so that a failure part way restores them: all outputs change, or none.
   std::vector<std::string> backups(files_.size());

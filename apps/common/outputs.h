@@ -51,9 +51,14 @@ public:
    * so that the link stays a link. */
   std::string stage(const std::string& final_path);
 
+  /** \brief Whether commit() would refuse a final path staged so far: an existing
+   * folder or other file that is not a regular one (a device, a FIFO, a socket), which
+   * renaming would replace. Lets a tool refuse before the work of making the file.
+   * \param[out] error the failure, naming the file */
+  bool check(std::string& error) const;
+
   /** \brief Rename every staged file to its final path. Refused, before anything is
-   * replaced, when a final path is an existing folder or other file that is not a
-   * regular one (a device, a FIFO, a socket): renaming would replace it.
+   * replaced, when check() fails.
    * \param[out] error the failure, naming the file */
   bool commit(std::string& error);
 
