@@ -12,18 +12,8 @@ endforeach()
 file(WRITE ${BLOCKED} "not a folder\n")
 
 set(failures "")
-# expect(<exit code> <regex the error output must match, or ""> <argument>...)
-function(expect code pattern)
-  execute_process(COMMAND ${LOOP} ${ARGN}
-    RESULT_VARIABLE rc OUTPUT_QUIET ERROR_VARIABLE err)
-  if(NOT rc EQUAL code)
-    set(failures "${failures}\n  '${ARGN}': exit '${rc}', expected ${code} (${err})"
-      PARENT_SCOPE)
-  elseif(NOT pattern STREQUAL "" AND NOT err MATCHES "${pattern}")
-    set(failures "${failures}\n  '${ARGN}': message '${err}' does not match '${pattern}'"
-      PARENT_SCOPE)
-  endif()
-endfunction()
+set(TOOL ${LOOP})
+include(${CMAKE_CURRENT_LIST_DIR}/expect_exit_code.cmake)
 
 expect(0 "" -h)
 # The help states the defaults the tool starts from (it once said tiles of 2 coarse

@@ -6,18 +6,8 @@ if(NOT DEFINED SIMULATE)
 endif()
 
 set(failures "")
-# expect(<exit code> <regex the error output must match, or ""> <argument>...)
-function(expect code pattern)
-  execute_process(COMMAND ${SIMULATE} ${ARGN}
-    RESULT_VARIABLE rc OUTPUT_QUIET ERROR_VARIABLE err)
-  if(NOT rc EQUAL code)
-    set(failures "${failures}\n  '${ARGN}': exit '${rc}', expected ${code} (${err})"
-      PARENT_SCOPE)
-  elseif(NOT pattern STREQUAL "" AND NOT err MATCHES "${pattern}")
-    set(failures "${failures}\n  '${ARGN}': message '${err}' does not match '${pattern}'"
-      PARENT_SCOPE)
-  endif()
-endfunction()
+set(TOOL ${SIMULATE})
+include(${CMAKE_CURRENT_LIST_DIR}/expect_exit_code.cmake)
 
 expect(0 "" -h)
 expect(2 "Unknown argument '-bogus'" -bogus 1)

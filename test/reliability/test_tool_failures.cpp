@@ -36,9 +36,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string tool;    // NOLINT: set once in main()
-std::string scan;    // NOLINT: set once in main()
-std::string compare; // NOLINT: set once in main(); pcl_selective_seg_compare
+std::string tool;     // NOLINT: set once in main()
+std::string scan;     // NOLINT: set once in main()
+std::string compare;  // NOLINT: set once in main(); pcl_selective_seg_compare
 std::string simulate; // NOLINT: set once in main(); pcl_selective_seg_simulate
 
 struct Outcome {

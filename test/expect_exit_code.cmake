@@ -1,0 +1,14 @@
+# Included by the ctest drivers (cmake -P) that check a tool's exit codes and messages.
+# expect(<exit code> <regex the error output must match, or ""> <argument>...) runs
+# ${TOOL} with the arguments and adds any mismatch to the variable `failures`.
+function(expect code pattern)
+  execute_process(COMMAND ${TOOL} ${ARGN}
+    RESULT_VARIABLE rc OUTPUT_QUIET ERROR_VARIABLE err)
+  if(NOT rc EQUAL code)
+    set(failures "${failures}\n  '${ARGN}': exit '${rc}', expected ${code} (${err})"
+      PARENT_SCOPE)
+  elseif(NOT pattern STREQUAL "" AND NOT err MATCHES "${pattern}")
+    set(failures "${failures}\n  '${ARGN}': message '${err}' does not match '${pattern}'"
+      PARENT_SCOPE)
+  endif()
+endfunction()
