@@ -856,6 +856,17 @@ main(int argc, char** argv)
   Options opt;
   if (const int rc = parseOptions(argc, argv, opt))
     return rc;
+  if (!opt.screenshot.empty()) {
+    // A screenshot path that is not a regular file (a folder, a FIFO, a device) is
+    // refused before the scan is read or a window opened.
+    selseg_apps::OutputTransaction target;
+    target.stage(opt.screenshot);
+    std::string error;
+    if (!target.check(error)) {
+      print_error("%s\n", error.c_str());
+      return kRuntimeError;
+    }
+  }
   Scene scene;
   if (!loadInput(opt, scene) || !checkDisplay() || !segment(opt, scene))
     return kRuntimeError;

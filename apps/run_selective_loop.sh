@@ -120,7 +120,7 @@ GNUPLOT
 if command -v xvfb-run > /dev/null; then
   viewer="$build/apps/pcl_selective_seg_viewer"
   shot() {
-    xvfb-run -a -s "-screen 0 1280x1024x24" "$viewer" "$@" -size 640x480 -no_legend \
+    xvfb-run -a -s "-screen 0 1280x1024x24 -noreset" "$viewer" "$@" -size 640x480 -no_legend \
       > /dev/null
   }
   for scene in cube chair door; do

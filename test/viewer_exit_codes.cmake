@@ -1,7 +1,10 @@
 # ctest driver (cmake -P): pcl_selective_seg_viewer's exit codes on help, usage errors,
-# unreadable input and a missing X display; none of these opens a window. With
-# -DXVFB_RUN, also -screenshot onto paths that are not regular files and a write that
-# fails part way, under a virtual X server.
+# unreadable input, a missing X display and -screenshot onto paths that are not regular
+# files; none of these opens a window. With -DXVFB_RUN, also a screenshot whose write
+# fails part way, and one that succeeds, under a virtual X server started with
+# -noreset: otherwise the server resets when the viewer disconnects and signals
+# xvfb-run (SIGUSR1) while it removes its temporary folder, which then fails now and
+# then (exit 5, "problem while cleaning up temporary directory", a stray Xvfb).
 #   -DVIEWER=<viewer> -DINPUT=<a readable scan> -DMISSING=<a path that does not exist>
 #   [-DXVFB_RUN=<xvfb-run>]
 foreach(var VIEWER INPUT MISSING)
@@ -57,49 +60,53 @@ file(REMOVE ${copy})
 # Without an X display: a message and exit 1, not VTK's abort.
 set(launcher ${CMAKE_COMMAND} -E env --unset=DISPLAY)
 expect(1 ${INPUT} -ignore_viewpoint -screenshot ${MISSING}.png)
+# A screenshot path that is not a regular file is refused before any display is needed
+# (a FIFO made the viewer wait for a reader for ever; the picture would have replaced
+# a device), the FIFO left as it is.
+set(out ${scratch}/viewer_exit_codes_out)
+file(REMOVE_RECURSE ${out})
+file(MAKE_DIRECTORY ${out}/folder.png)
+execute_process(COMMAND mkfifo ${out}/fifo.png)
+# expect_error(<exit code> <regex of the error output> <argument>...)
+function(expect_error code pattern)
+  execute_process(COMMAND ${launcher} ${VIEWER} ${ARGN}
+    RESULT_VARIABLE rc OUTPUT_QUIET ERROR_VARIABLE err TIMEOUT 120)
+  if(NOT rc EQUAL code OR NOT err MATCHES "${pattern}")
+    set(failures "${failures}\n  '${ARGN}': exit '${rc}', expected ${code} and "
+      "'${pattern}' (${err})" PARENT_SCOPE)
+  endif()
+endfunction()
+set(view ${INPUT} -ignore_viewpoint -size 320x240 -screenshot)
+expect_error(1 "'.*fifo.png': it is not a regular file" ${view} ${out}/fifo.png)
+expect_error(1 "'.*folder.png': it is a folder" ${view} ${out}/folder.png)
+execute_process(COMMAND test -p ${out}/fifo.png RESULT_VARIABLE fifo_rc)
+if(NOT fifo_rc EQUAL 0)
+  set(failures "${failures}\n  the FIFO given to -screenshot is not a FIFO any more")
+endif()
+file(REMOVE_RECURSE ${out})
 
 # The screenshot is written to a temporary and renamed into place (OutputTransaction):
-# a folder, FIFO or device is refused before rendering (a FIFO made the viewer wait
-# for a reader for ever), and a failed write leaves no partial picture and the old one
-# unchanged.
+# a failed write leaves no partial picture and the old one unchanged.
 if(XVFB_RUN)
   set(out ${scratch}/viewer_exit_codes_out)
   file(REMOVE_RECURSE ${out})
-  file(MAKE_DIRECTORY ${out}/folder.png)
-  execute_process(COMMAND mkfifo ${out}/fifo.png)
+  file(MAKE_DIRECTORY ${out})
   file(WRITE ${out}/old.png "old\n")
-  # expect_error(<exit code> <regex of the error output> <argument>...)
-  function(expect_error code pattern)
-    execute_process(COMMAND ${launcher} ${VIEWER} ${ARGN}
-      RESULT_VARIABLE rc OUTPUT_QUIET ERROR_VARIABLE err TIMEOUT 120)
-    if(NOT rc EQUAL code OR NOT err MATCHES "${pattern}")
-      set(failures "${failures}\n  '${ARGN}': exit '${rc}', expected ${code} and "
-        "'${pattern}' (${err})" PARENT_SCOPE)
-    endif()
-  endfunction()
-  set(view ${INPUT} -ignore_viewpoint -size 320x240 -screenshot)
-  set(launcher ${XVFB_RUN} -a -s "-screen 0 1280x1024x24")
-  expect_error(1 "'.*fifo.png': it is not a regular file" ${view} ${out}/fifo.png)
-  expect_error(1 "'.*folder.png': it is a folder" ${view} ${out}/folder.png)
   # A file size limit of 4 KiB (the picture is about 130 KiB): the write fails.
-  set(launcher ${XVFB_RUN} -a -s "-screen 0 1280x1024x24"
+  set(launcher ${XVFB_RUN} -a -s "-screen 0 1280x1024x24 -noreset"
     sh -c "ulimit -f 4 && trap '' XFSZ && exec \"$0\" \"$@\"")
   expect_error(1 "Cannot write the PNG '.*old.png'" ${view} ${out}/old.png)
   file(READ ${out}/old.png old)
-  execute_process(COMMAND test -p ${out}/fifo.png RESULT_VARIABLE fifo_rc)
   file(GLOB left RELATIVE ${out} ${out}/*)
-  list(SORT left)
-  if(NOT old STREQUAL "old\n" OR NOT fifo_rc EQUAL 0
-     OR NOT left STREQUAL "fifo.png;folder.png;old.png")
-    set(failures "${failures}\n  failed screenshots changed the folder: '${left}', "
-      "old.png '${old}', fifo.png still a FIFO: ${fifo_rc} (0: yes)")
+  if(NOT old STREQUAL "old\n" OR NOT left STREQUAL "old.png")
+    set(failures "${failures}\n  a failed screenshot changed the folder: '${left}', "
+      "old.png '${old}'")
   endif()
-  set(launcher ${XVFB_RUN} -a -s "-screen 0 1280x1024x24")
+  set(launcher ${XVFB_RUN} -a -s "-screen 0 1280x1024x24 -noreset")
   expect_error(0 "" ${view} ${out}/old.png)
   file(SIZE ${out}/old.png size)
   file(GLOB left RELATIVE ${out} ${out}/*)
-  list(SORT left)
-  if(size LESS 1024 OR NOT left STREQUAL "fifo.png;folder.png;old.png")
+  if(size LESS 1024 OR NOT left STREQUAL "old.png")
     set(failures "${failures}\n  the screenshot has ${size} bytes, the folder '${left}'")
   endif()
   file(REMOVE_RECURSE ${out})

@@ -12,7 +12,7 @@ endforeach()
 file(REMOVE ${PNG})
 # A 24-bit screen: xvfb-run's default 8-bit one has no true-colour visual for OpenGL.
 execute_process(
-  COMMAND ${XVFB_RUN} -a -s "-screen 0 1280x1024x24"
+  COMMAND ${XVFB_RUN} -a -s "-screen 0 1280x1024x24 -noreset"
     ${VIEWER} ${INPUT} ${VIEWER_ARGS} -view ${VIEW}
     -screenshot ${PNG} -size ${WIDTH}x${HEIGHT}
   RESULT_VARIABLE viewer_rc)
