@@ -8,17 +8,15 @@ endif()
 
 set(SELSEG_VIEWER_SCAN ${PROJECT_SOURCE_DIR}/data/table_scene_mug_stereo_textured.pcd)
 
-# With xvfb-run, viewer_exit_codes also checks the screenshot's failures under it.
-find_program(XVFB_RUN xvfb-run)
 add_test(NAME viewer_exit_codes
   COMMAND ${CMAKE_COMMAND}
     -DVIEWER=$<TARGET_FILE:pcl_selective_seg_viewer>
     -DINPUT=${SELSEG_VIEWER_SCAN}
     -DMISSING=${CMAKE_CURRENT_BINARY_DIR}/no_such_scan.pcd
-    -DXVFB_RUN=${XVFB_RUN}
     -P ${CMAKE_CURRENT_LIST_DIR}/viewer_exit_codes.cmake)
-# One virtual X server at a time (viewer_screenshot_*).
-set_tests_properties(viewer_exit_codes PROPERTIES RESOURCE_LOCK xvfb TIMEOUT 300)
+set_tests_properties(viewer_exit_codes PROPERTIES TIMEOUT 300)
+
+find_program(XVFB_RUN xvfb-run)
 
 if(NOT XVFB_RUN)
   message(STATUS "xvfb-run not found (apt-get install xvfb xauth libgl1-mesa-dri): "
@@ -37,6 +35,16 @@ add_executable(check_screenshot ${CMAKE_CURRENT_LIST_DIR}/check_screenshot.cpp)
 target_link_libraries(check_screenshot PRIVATE
   VTK::IOImage VTK::CommonDataModel VTK::CommonCore)
 target_compile_options(check_screenshot PRIVATE -Wall -Wextra)
+
+# viewer_screenshot_write: a screenshot whose write fails part way, then one that works.
+add_test(NAME viewer_screenshot_write
+  COMMAND ${CMAKE_COMMAND}
+    -DXVFB_RUN=${XVFB_RUN}
+    -DVIEWER=$<TARGET_FILE:pcl_selective_seg_viewer>
+    -DINPUT=${SELSEG_VIEWER_SCAN}
+    -DOUT=${CMAKE_CURRENT_BINARY_DIR}/viewer_screenshot_write_out
+    -P ${CMAKE_CURRENT_LIST_DIR}/viewer_screenshot_write_test.cmake)
+set_tests_properties(viewer_screenshot_write PROPERTIES RESOURCE_LOCK xvfb TIMEOUT 300)
 
 # viewer_screenshot_<view>: at 640x480, at least 6 of the 12 hue sectors must each
 # hold 1000 saturated pixels (0.3% of the picture; the mug scene gives over 3000).
