@@ -123,6 +123,27 @@ TEST(BoundaryDistances, HandComputed)
   EXPECT_DOUBLE_EQ(d.max, 1.0);
 }
 
+TEST(BoundaryDistances, PointsBeyondTheSearchRangeAreSkipped)
+{
+  // Squared distances of 1e30 m overflow the search's float: such a point would be
+  // taken as nearest at random. It is skipped like a non-finite one.
+  metrics::BoundaryDistances d;
+  std::vector<float> per_point;
+  metrics::boundaryDistances(
+      line({0.0f, 1e30f}), line({1e30f, -5e29f, 3.0f}), d, &per_point);
+  EXPECT_EQ(d.num_from, 1u);
+  EXPECT_EQ(d.num_to, 1u);
+  EXPECT_DOUBLE_EQ(d.max, 3.0);
+  EXPECT_FLOAT_EQ(per_point[0], 3.0f);
+  EXPECT_TRUE(std::isnan(per_point[1]));
+  // At the limit itself points still count.
+  const float edge = metrics::kMaxMetricCoordinate;
+  metrics::boundaryDistances(line({edge}), line({edge, 0.0f}), d);
+  EXPECT_EQ(d.num_from, 1u);
+  EXPECT_EQ(d.num_to, 2u);
+  EXPECT_DOUBLE_EQ(d.max, 0.0);
+}
+
 TEST(BoundaryDistances, EmptySetsGiveNaN)
 {
   metrics::BoundaryDistances d;
@@ -291,4 +312,33 @@ TEST(DescribeBoundaryPoints, BadInput)
   ASSERT_EQ(kinds.size(), 1u);
   EXPECT_FALSE(kinds[0].depth_jump);
   EXPECT_TRUE(std::isnan(kinds[0].crease_angle));
+}
+
+TEST(DescribeBoundaryPoints, PointListedTwiceIsDescribedTwice)
+{
+  const Grid g = twoFaces(0.3, 0.0);
+  pcl::Indices boundary;
+  const auto kinds = describe(g, &boundary);
+  ASSERT_FALSE(boundary.empty());
+  pcl::Indices twice = boundary;
+  twice.push_back(boundary.front());
+  std::vector<metrics::BoundaryEdgeKind> again;
+  ASSERT_TRUE(metrics::describeBoundaryPoints(g.cloud,
+                                              g.triangles,
+                                              g.labels,
+                                              Eigen::Vector3f::Zero(),
+                                              M_PI,
+                                              85.0 * M_PI / 180.0,
+                                              twice,
+                                              again));
+  ASSERT_EQ(again.size(), twice.size());
+  for (std::size_t k = 0; k < twice.size(); ++k) {
+    const auto& expected = kinds[k < boundary.size() ? k : 0];
+    EXPECT_EQ(again[k].depth_jump, expected.depth_jump) << k;
+    if (std::isnan(expected.crease_angle))
+      EXPECT_TRUE(std::isnan(again[k].crease_angle)) << k;
+    else
+      EXPECT_FLOAT_EQ(again[k].crease_angle, expected.crease_angle) << k;
+  }
+  EXPECT_FALSE(std::isnan(again.front().crease_angle));
 }

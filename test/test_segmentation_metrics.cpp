@@ -261,6 +261,29 @@ TEST(HooverSweep, RejectsBadRange)
   EXPECT_FALSE(metrics::hooverSweep({1}, {1}, sweep, 0.9, 0.8, 0.05));
   EXPECT_FALSE(metrics::hooverSweep({1}, {1}, sweep, 0.5, 0.9, 0.0));
   EXPECT_FALSE(metrics::hooverSweep({1}, {1, 1}, sweep));
+  // An infinite step, or one too small to move the tolerance (a loop adding steps
+  // until it passed the maximum would never end), is refused.
+  EXPECT_FALSE(metrics::hooverSweep(
+      {1}, {1}, sweep, 0.5, 1.0, std::numeric_limits<double>::infinity()));
+  EXPECT_FALSE(metrics::hooverSweep({1}, {1}, sweep, 0.5, 1.0, 1e-300));
+  EXPECT_FALSE(metrics::hooverSweep({1}, {1}, sweep, 0.5, 1.0, 1e-6));
+  EXPECT_TRUE(sweep.empty());
+}
+
+TEST(HooverSweep, CountsTheTolerancesFirst)
+{
+  std::vector<metrics::HooverScores> sweep;
+  // min == max: one tolerance, whatever the step.
+  ASSERT_TRUE(metrics::hooverSweep({1}, {1}, sweep, 0.5, 0.5, 1e-20));
+  ASSERT_EQ(sweep.size(), 1u);
+  EXPECT_EQ(sweep[0].tolerance, 0.5);
+  EXPECT_EQ(counts(sweep[0]), (Counts{1, 0, 0, 0, 0}));
+  // 0.5 to 1 by 1e-5: 50,001 tolerances, increasing, the last 1.
+  ASSERT_TRUE(metrics::hooverSweep({1}, {1}, sweep, 0.5, 1.0, 1e-5));
+  ASSERT_EQ(sweep.size(), 50001u);
+  EXPECT_EQ(sweep.back().tolerance, 1.0);
+  for (std::size_t i = 1; i < sweep.size(); ++i)
+    ASSERT_GT(sweep[i].tolerance, sweep[i - 1].tolerance) << i;
 }
 
 TEST(MajorityLabels, TieGoesToSmallerGroundTruthLabel)

@@ -23,6 +23,18 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
+/** Largest number of tolerances hooverSweep() makes. */
+constexpr double kMaxSweepTolerances = 100000;
+
+/** Finite, and no coordinate beyond kMaxMetricCoordinate [m]: the nearest-neighbour
+ * searches compare squared distances in float, which overflow beyond about 1.8e19 m. */
+bool
+measurable(const pcl::PointXYZ& p)
+{
+  return pcl::isFinite(p) &&
+         p.getVector3fMap().cwiseAbs().maxCoeff() <= kMaxMetricCoordinate;
+}
+
 /** count >= fraction * total, with a margin of 1e-9 * total for the rounding of the
  * fraction (see the namespace documentation). */
 bool
@@ -234,21 +246,32 @@ hooverSweep(const std::vector<std::uint32_t>& predicted,
 {
   sweep.clear();
   if (!validTolerance(min_tolerance) || !validTolerance(max_tolerance) ||
-      max_tolerance < min_tolerance || !(step > 0.0)) {
+      max_tolerance < min_tolerance || !(step > 0.0) || !std::isfinite(step)) {
     PCL_ERROR("[pcl::selective_seg::metrics::hooverSweep] bad range %g..%g step %g "
-              "(need 0.5 <= min <= max <= 1, step > 0)\n",
+              "(need 0.5 <= min <= max <= 1, a finite step > 0)\n",
               min_tolerance,
               max_tolerance,
               step);
     return false;
   }
+  // Tolerance i is min + i step while it exceeds max by at most step / 1000. Counted
+  // first: a loop that added steps until it passed max would never end for a step too
+  // small to move min.
+  const double last = std::floor((max_tolerance - min_tolerance) / step + 1e-3);
+  if (!(last < kMaxSweepTolerances)) {
+    PCL_ERROR("[pcl::selective_seg::metrics::hooverSweep] step %g makes more than %g "
+              "tolerances from %g to %g: use a larger step\n",
+              step,
+              kMaxSweepTolerances,
+              min_tolerance,
+              max_tolerance);
+    return false;
+  }
   LabelOverlap overlap;
   if (!buildLabelOverlap(predicted, ground_truth, overlap))
     return false;
-  for (std::size_t i = 0;; ++i) {
+  for (std::size_t i = 0; i <= static_cast<std::size_t>(last); ++i) {
     const double tolerance = min_tolerance + static_cast<double>(i) * step;
-    if (tolerance > max_tolerance + 1e-3 * step)
-      break;
     sweep.push_back(hooverScores(overlap, std::min(tolerance, max_tolerance)));
   }
   return true;
@@ -333,7 +356,7 @@ validPoints(const pcl::PointCloud<pcl::PointXYZ>& cloud,
   auto valid = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
   input_index.clear();
   for (std::size_t i = 0; i < cloud.size(); ++i) {
-    if (ground_truth[i] != 0 && pcl::isFinite(cloud[i])) {
+    if (ground_truth[i] != 0 && measurable(cloud[i])) {
       valid->push_back(cloud[i]);
       input_index.push_back(i);
     }
@@ -704,6 +727,9 @@ describeBoundaryPoints(const pcl::PointCloud<pcl::PointXYZ>& cloud,
         if (std::isnan(kind.crease_angle) || angle > kind.crease_angle)
           kind.crease_angle = angle;
       });
+  // A point listed more than once was described at its last place: copy that.
+  for (std::size_t k = 0; k < boundary.size(); ++k)
+    kinds[k] = kinds[slot[boundary[k]]];
   return true;
 }
 
@@ -718,7 +744,7 @@ boundaryDistances(const pcl::PointCloud<pcl::PointXYZ>& from,
     per_point->assign(from.size(), std::numeric_limits<float>::quiet_NaN());
   auto targets = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
   for (const auto& p : to)
-    if (pcl::isFinite(p))
+    if (measurable(p))
       targets->push_back(p);
   result.num_to = targets->size();
   std::vector<double> distances;
@@ -730,7 +756,7 @@ boundaryDistances(const pcl::PointCloud<pcl::PointXYZ>& from,
     std::vector<float> sqr(1);
     for (std::size_t i = 0; i < from.size(); ++i) {
       const auto& p = from[i];
-      if (!pcl::isFinite(p) || tree.nearestKSearch(p, 1, index, sqr) != 1)
+      if (!measurable(p) || tree.nearestKSearch(p, 1, index, sqr) != 1)
         continue;
       distances.push_back(((*targets)[index[0]].getVector3fMap() - p.getVector3fMap())
                               .cast<double>()
@@ -740,7 +766,7 @@ boundaryDistances(const pcl::PointCloud<pcl::PointXYZ>& from,
     }
   } else
     for (const auto& p : from)
-      if (pcl::isFinite(p))
+      if (measurable(p))
         distances.push_back(kNaN);
   result.num_from = distances.size();
   if (distances.empty() || targets->empty()) {

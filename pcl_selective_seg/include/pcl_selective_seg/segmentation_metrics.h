@@ -38,6 +38,11 @@ namespace selective_seg {
  */
 namespace metrics {
 
+/** \brief Largest coordinate magnitude of a point the distance-based metrics use [m]:
+ * their nearest-neighbour searches compare squared distances in float, which overflow
+ * beyond about 1.8e19 m. Points beyond it are skipped like non-finite ones. */
+constexpr float kMaxMetricCoordinate = 1e18f;
+
 /** \brief One nonzero entry O_mn of the overlap table. */
 struct OverlapEntry {
   std::size_t gt = 0;        ///< index of the GT region in LabelOverlap::gt_labels
@@ -134,15 +139,16 @@ PCL_EXPORTS bool hooverMetrics(const std::vector<std::uint32_t>& predicted,
  *
  * Tolerances are min_tolerance + i * step for i = 0, 1, ... while they do not exceed
  * max_tolerance by more than step / 1000 (so 0.5..0.95 by 0.05 gives 10 values, the
- * last 0.95). The overlap table is built once.
+ * last 0.95), at most 100,000 of them. The overlap table is built once.
  *
  * \param[in] predicted \#N predicted labels, 0 = unlabeled
  * \param[in] ground_truth \#N GT labels, 0 = invalid (ignored)
  * \param[out] sweep one HooverScores per tolerance, increasing; empty on failure
  * \param[in] min_tolerance first T, in [0.5, 1]
  * \param[in] max_tolerance last T, in [min_tolerance, 1]
- * \param[in] step increment of T, > 0
- * \return false (with PCL_ERROR) on a length mismatch or a bad range
+ * \param[in] step increment of T, finite and > 0
+ * \return false (with PCL_ERROR) on a length mismatch, a bad range, or a step that
+ *         would make more than 100,000 tolerances
  */
 PCL_EXPORTS bool hooverSweep(const std::vector<std::uint32_t>& predicted,
                              const std::vector<std::uint32_t>& ground_truth,
@@ -229,7 +235,8 @@ struct BoundaryRecall {
 
 /** \brief Recall of the GT object boundaries by the predicted region boundaries.
  *
- * Only GT-valid points with finite coordinates take part (GT-invalid points neither
+ * Only GT-valid points with finite coordinates, none beyond kMaxMetricCoordinate, take
+ * part (GT-invalid points neither
  * make nor break a boundary). Neighbours are the points closer than \a radius
  * (pcl::search::KdTree radius search, strict).
  * - GT boundary point: a point with a neighbour of another GT label.
@@ -346,7 +353,8 @@ struct BoundaryEdgeKind {
  * \param[in] max_view_incidence_angle edges closer than 90 deg minus this to the line
  *            of sight are depth jumps [rad], in (0, pi/2]
  * \param[in] boundary the boundary points (labelBoundaryPoints() of the same input)
- * \param[out] kinds one per boundary point, in its order; empty on failure
+ * \param[out] kinds one per boundary point, in its order (a point listed twice is
+ *             described twice, the same way); empty on failure
  * \return false (with PCL_ERROR) on the inputs labelBoundaryPoints() refuses, a bad
  *         incidence angle or a boundary index out of range
  */
@@ -379,8 +387,9 @@ struct BoundaryDistances {
  * segment boundary. The reverse direction measures spurious boundaries.
  * Percentiles use the nearest rank: the value at position ceil(q n) of the sorted
  * distances.
- * \param[in] from points to measure [m]; non-finite points are skipped
- * \param[in] to points to measure to [m]; non-finite points are skipped
+ * \param[in] from points to measure [m]; non-finite points, and points with a
+ *            coordinate beyond kMaxMetricCoordinate, are skipped
+ * \param[in] to points to measure to [m]; skipped likewise
  * \param[out] result the statistics
  * \param[out] per_point if non-null: the distance of every point of \a from, in its
  *             order (NaN for skipped points or an empty \a to)
