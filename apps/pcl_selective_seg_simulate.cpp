@@ -27,6 +27,8 @@
 #include <set>
 #include <string>
 
+#include "segmentation_options.h"
+
 using namespace pcl::console;
 namespace sim = pcl::selective_seg::simulation;
 
@@ -66,7 +68,7 @@ printHelp(const char* program)
   print_info("  -holes N             number of elliptic holes without returns, in "
              "[0, 1000] (default %d)\n",
              d.num_holes);
-  print_info("  -hole_radius_deg X   mean semi-axis of a hole [deg], in [0, 57.3] "
+  print_info("  -hole_radius_deg X   mean semi-axis of a hole [deg], in [0, 57.29] "
              "(default %g)\n",
              d.hole_radius / kDeg);
   print_info("  -seed S              random seed, integer in [0, 4294967295] "
@@ -77,26 +79,12 @@ printHelp(const char* program)
   print_info("  -h, --help           this help\n");
 }
 
-/** A checked numeric option: absent is fine, present and unparsable is a usage error.
- */
-bool
-parseNumber(int argc, char** argv, const char* flag, double& value)
-{
-  if (find_argument(argc, argv, flag) < 0)
-    return true;
-  if (parse_argument(argc, argv, flag, value) < 0 || !std::isfinite(value)) {
-    print_error("Option %s needs a number.\n", flag);
-    return false;
-  }
-  return true;
-}
-
 /** A checked integer option in [lo, hi]. */
 bool
 parseInteger(
     int argc, char** argv, const char* flag, double lo, double hi, double& value)
 {
-  if (!parseNumber(argc, argv, flag, value))
+  if (!selseg_apps::parseNumber(argc, argv, flag, value))
     return false;
   if (value != std::floor(value) || value < lo || value > hi) {
     print_error("Option %s needs an integer in [%.0f, %.0f].\n", flag, lo, hi);
@@ -155,6 +143,7 @@ parseOptions(int argc, char** argv, Options& opt)
   double holes = s.num_holes;
   double seed = s.seed;
   double hole_radius_deg = s.hole_radius / kDeg;
+  using selseg_apps::parseNumber;
   if (!parseNumber(argc, argv, "-density", opt.density) ||
       !parseNumber(argc, argv, "-noise", s.range_noise) ||
       !parseNumber(argc, argv, "-density_ratio", s.density_ratio) ||
@@ -165,6 +154,13 @@ parseOptions(int argc, char** argv, Options& opt)
     return kUsageError;
   if (!(opt.density > 0.0)) {
     print_error("Option -density needs a value > 0.\n");
+    return kUsageError;
+  }
+  // The simulator takes radians, at most 1: checked here so that the message names
+  // the option and its unit.
+  if (!(hole_radius_deg >= 0.0 && hole_radius_deg * kDeg <= 1.0)) {
+    print_error("Option -hole_radius_deg needs a value in [0, %.2f] (1 rad).\n",
+                std::floor(100.0 / kDeg) / 100.0);
     return kUsageError;
   }
   // makePaperScene() caps the rays at the simulator's limit, num_rays <= 1e8: a larger

@@ -12,6 +12,8 @@ include(${CMAKE_CURRENT_LIST_DIR}/expect_exit_code.cmake)
 expect(0 "" -h)
 expect(2 "Unknown argument '-bogus'" -bogus 1)
 expect(2 "needs a value > 0" -density 0)
+expect(2 "Option -hole_radius_deg needs a value in \\[0, 57.29\\]" -hole_radius_deg 57.3)
+expect(0 "" -hole_radius_deg 57.29)
 # A repeated option (the first value was used silently).
 expect(2 "Option -density is given more than once" -density 2 -density 3)
 expect(2 "Option -o is given more than once" -o a.pcd -o b.pcd)

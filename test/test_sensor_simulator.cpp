@@ -580,7 +580,85 @@ TEST(ValidateScene, RejectsBadPrimitives)
   EXPECT_TRUE(cloud.empty());
 }
 
+TEST(ValidateScene, HeightFieldFunctionsAreChecked)
+{
+  sim::Scene scene = wallScene();
+  std::string why;
+  // A height outside the declared bounds: the rays, which search between the bounds,
+  // would miss that part of the surface.
+  scene.height_fields.push_back(
+      squareField([](double s, double) { return s < 0.5 ? 1.5 : 0.0; }, -0.1, 0.1));
+  EXPECT_FALSE(sim::validateScene(scene, &why));
+  EXPECT_NE(std::string::npos, why.find("outside [min_height, max_height]")) << why;
+  // A label function that gives 0 on half the panel.
+  scene.height_fields[0] = squareField([](double, double) { return 0.0; }, 0.0, 0.0);
+  scene.height_fields[0].label = [](double s, double) { return s < 0.5 ? 0u : 1u; };
+  EXPECT_FALSE(sim::validateScene(scene, &why));
+  EXPECT_NE(std::string::npos, why.find("label(")) << why;
+}
+
+TEST(SensorSimulator, HitWithLabelZeroFailsTheScan)
+{
+  // Label 0 in a strip too narrow for validateScene()'s grid (s in (0.51, 0.54)):
+  // the scan fails instead of writing points of label 0.
+  sim::Scene scene;
+  scene.height_fields.push_back(
+      squareField([](double, double) { return 0.0; }, 0.0, 0.0));
+  scene.height_fields[0].label = [](double s, double) {
+    return s > 0.51 && s < 0.54 ? 0u : 1u;
+  };
+  scene.label_names[1] = "panel";
+  ASSERT_TRUE(sim::validateScene(scene));
+  sim::SensorParameters sensor;
+  sensor.num_rays = 20000;
+  sim::SensorSimulator simulator;
+  ASSERT_TRUE(simulator.setParameters(sensor));
+  Cloud cloud;
+  sim::SimulationDetails d;
+  EXPECT_FALSE(simulator.simulate(scene, cloud, &d));
+  EXPECT_TRUE(cloud.empty());
+  EXPECT_GT(d.unlabeled_hits, 0u);
+  sim::ScanWindow window;
+  window.theta_min = -0.02;
+  window.theta_max = 0.1;
+  window.step = 0.002;
+  EXPECT_FALSE(simulator.simulateWindow(scene, window, cloud, &d));
+  EXPECT_TRUE(cloud.empty());
+  // Without the strip the same scan succeeds.
+  scene.height_fields[0].label = [](double, double) { return 1u; };
+  EXPECT_TRUE(simulator.simulate(scene, cloud, &d));
+  EXPECT_FALSE(cloud.empty());
+}
+
 // ---------------------------------------------------------------- sensor model
+
+TEST(SensorSimulator, ThinWindowsCastAboutTheRaysAsked)
+{
+  // A window 3 rad wide and a fraction of a ray's spacing high: the candidate grid
+  // has one row, and as many columns as the rays asked (not the width over the
+  // height, which was 1e16 columns for a height of 3e-16 rad).
+  sim::Scene scene = wallScene();
+  for (const double height : {3.08e-4, 1e-5, 3e-16}) {
+    for (const std::size_t rays : {std::size_t{1}, std::size_t{10000}}) {
+      sim::SensorParameters sensor;
+      sensor.theta_min = -1.5;
+      sensor.theta_max = 1.5;
+      sensor.phi_min = 0.0;
+      sensor.phi_max = height;
+      sensor.density_ratio = 1.0;
+      sensor.num_rays = rays;
+      sim::SensorSimulator simulator;
+      ASSERT_TRUE(simulator.setParameters(sensor));
+      Cloud cloud;
+      sim::SimulationDetails d;
+      ASSERT_TRUE(simulator.simulate(scene, cloud, &d));
+      EXPECT_GE(static_cast<double>(d.candidates), 0.95 * static_cast<double>(rays))
+          << height << " " << rays;
+      EXPECT_LE(static_cast<double>(d.candidates), 1.05 * static_cast<double>(rays) + 1)
+          << height << " " << rays;
+    }
+  }
+}
 
 TEST(SensorParameters, RejectsOutOfRange)
 {
@@ -602,6 +680,20 @@ TEST(SensorParameters, RejectsOutOfRange)
   EXPECT_TRUE(bad([](auto& p) { p.hole_radius = std::nan(""); }));
   EXPECT_TRUE(bad([](auto& p) { p.range_noise = -0.1; }));
   EXPECT_TRUE(bad([](auto& p) { p.max_range = p.min_range; }));
+  // Farther hits could not be written as float coordinates.
+  EXPECT_TRUE(bad([](auto& p) { p.max_range = 1e300; }));
+  EXPECT_FALSE(bad([](auto& p) { p.max_range = 1e30; }));
+  // The message names the bound that is wrong, with both values.
+  sim::SensorParameters wrong;
+  wrong.theta_max = wrong.theta_min - 0.1;
+  std::string message;
+  EXPECT_FALSE(wrong.validate(&message));
+  EXPECT_NE(std::string::npos, message.find("theta_max [rad] = -0.6")) << message;
+  EXPECT_NE(std::string::npos, message.find("above theta_min = -0.5")) << message;
+  wrong = sim::SensorParameters();
+  wrong.phi_max = std::nan("");
+  EXPECT_FALSE(wrong.validate(&message));
+  EXPECT_NE(std::string::npos, message.find("phi_max")) << message;
   sim::SensorSimulator simulator;
   sim::SensorParameters p;
   p.dropout = 2.0;
@@ -802,7 +894,10 @@ TEST(SensorSimulator, RayCountsAddUp)
   const auto setup = sim::makeChairScene();
   sim::SimulationDetails d;
   const Cloud cloud = simulate(setup.scene, setup.sensor, &d);
-  EXPECT_EQ(d.rays, d.in_holes + d.dropped + d.missed + d.out_of_range + cloud.size());
+  EXPECT_EQ(d.rays,
+            d.in_holes + d.dropped + d.missed + d.out_of_range + d.unlabeled_hits +
+                cloud.size());
+  EXPECT_EQ(0u, d.unlabeled_hits);
   EXPECT_GT(d.missed, 0u);
   EXPECT_GE(d.candidates, d.rays);
   EXPECT_EQ(1u, cloud.height);

@@ -208,6 +208,7 @@ TEST_F(Tool, BadOptionsAreUsageErrors)
   EXPECT_EQ(run(in + " -sensor_origin 1,2"), 2);
   EXPECT_EQ(run(in + " -unit_scale 0"), 2);
   EXPECT_EQ(run(in + " -threads -1"), 2);
+  EXPECT_EQ(run(in + " -threads ''"), 2); // empty: pcl::console would read 0 (all cores)
   // A repeated option: pcl::console's parsers used the first value silently.
   EXPECT_EQ(run(in + " -o " + out("second.pcd")), 2);
   EXPECT_EQ(run(in + " -split_deg 5 -split_deg 30"), 2);

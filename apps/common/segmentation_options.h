@@ -18,15 +18,18 @@
 
 namespace selseg_apps {
 
-/** \brief A checked number: absent is fine; present and not a finite number prints an
- * error and returns false (pcl::console::parse_argument alone would store 0). */
+/** \brief A checked number: absent is fine; present and not a finite number (an empty
+ * value included) prints an error and returns false (pcl::console::parse_argument
+ * alone would store 0). */
 template <typename T>
 bool
 parseNumber(int argc, char** argv, const char* flag, T& value)
 {
-  if (pcl::console::find_argument(argc, argv, flag) < 0)
+  const int at = pcl::console::find_argument(argc, argv, flag);
+  if (at < 0)
     return true;
-  if (pcl::console::parse_argument(argc, argv, flag, value) < 0 ||
+  if (at + 1 >= argc || argv[at + 1][0] == '\0' ||
+      pcl::console::parse_argument(argc, argv, flag, value) < 0 ||
       !std::isfinite(static_cast<double>(value))) {
     pcl::console::print_error("Option %s needs a number (see -h).\n", flag);
     return false;

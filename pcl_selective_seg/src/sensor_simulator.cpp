@@ -11,6 +11,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
+#include <limits>
 #include <random>
 #include <sstream>
 #include <utility>
@@ -38,6 +40,13 @@ constexpr int kTextureGrid = 65;
 /** Padding of a height field's height slab: this many metres, plus this fraction of
  * its largest height bound. */
 constexpr double kSlabPadding = 1e-9;
+
+/** Largest max_range [m]: beyond it a hit's float coordinates could overflow. */
+constexpr double kMaxSimulatedRange = 1e30;
+
+/** Samples per side of the grid on which validateScene() checks a height field's
+ * functions against its bounds and labels. */
+constexpr int kFieldCheckGrid = 17;
 
 /** Plane waves summed into the texture field. */
 constexpr int kTextureWaves = 6;
@@ -508,6 +517,29 @@ validateCurved(const Scene& scene, std::string* why)
         !std::isfinite(h.min_height) || !std::isfinite(h.max_height) ||
         h.min_height > h.max_height || !(h.max_step > 0.0))
       return fail(why, describe("height field", i, "degenerate or bad bounds/step"));
+    // The functions are the caller's: spot-check them on a grid. A height outside the
+    // bounds would be missed by the rays (they search between the bounds only), and a
+    // label 0 would be written as a point without a surface.
+    const double pad =
+        kSlabPadding * (1.0 + std::max(std::abs(h.min_height), std::abs(h.max_height)));
+    for (int a = 0; a < kFieldCheckGrid; ++a)
+      for (int b = 0; b < kFieldCheckGrid; ++b) {
+        const double fs = static_cast<double>(a) / (kFieldCheckGrid - 1);
+        const double ft = static_cast<double>(b) / (kFieldCheckGrid - 1);
+        const double z = h.height(fs, ft);
+        if (!(z >= h.min_height - pad && z <= h.max_height + pad)) {
+          std::ostringstream m;
+          m << std::setprecision(17) << "height(" << fs << ", " << ft << ") = " << z
+            << " outside [min_height, max_height] = [" << h.min_height << ", "
+            << h.max_height << "]";
+          return fail(why, describe("height field", i, m.str().c_str()));
+        }
+        if (h.label(fs, ft) == 0) {
+          std::ostringstream m;
+          m << "label(" << fs << ", " << ft << ") = 0 (labels are >= 1)";
+          return fail(why, describe("height field", i, m.str().c_str()));
+        }
+      }
   }
   return true;
 }
@@ -522,11 +554,20 @@ validateScene(const Scene& scene, std::string* why)
 
 namespace {
 
+/** "parameter NAME = VALUE is invalid: valid range RANGE", with \a bound after the
+ * range when it names another parameter's value. */
 bool
-reject(std::string* why, const char* name, double value, const char* range)
+reject(std::string* why,
+       const char* name,
+       double value,
+       const char* range,
+       double bound = std::numeric_limits<double>::quiet_NaN())
 {
   std::ostringstream s;
-  s << "parameter " << name << " = " << value << " is invalid: valid range " << range;
+  s << std::setprecision(12) << "parameter " << name << " = " << value
+    << " is invalid: valid range " << range;
+  if (!std::isnan(bound))
+    s << " = " << bound;
   return fail(why, s.str());
 }
 
@@ -540,14 +581,18 @@ bool
 validateWindow(const SensorParameters& p, std::string* why)
 {
   const double limit = 0.5 * kPi;
-  if (!(p.theta_min > -limit && p.theta_min < p.theta_max))
-    return reject(why, "theta_min [rad]", p.theta_min, "(-pi/2, theta_max)");
-  if (!(p.theta_max < limit))
-    return reject(why, "theta_max [rad]", p.theta_max, "(theta_min, pi/2)");
-  if (!(p.phi_min > -limit && p.phi_min < p.phi_max))
-    return reject(why, "phi_min [rad]", p.phi_min, "(-pi/2, phi_max)");
-  if (!(p.phi_max < limit))
-    return reject(why, "phi_max [rad]", p.phi_max, "(phi_min, pi/2)");
+  if (!(p.theta_min > -limit && p.theta_min < limit))
+    return reject(why, "theta_min [rad]", p.theta_min, "(-pi/2, pi/2)");
+  if (!(p.theta_max > -limit && p.theta_max < limit))
+    return reject(why, "theta_max [rad]", p.theta_max, "(-pi/2, pi/2)");
+  if (!(p.theta_min < p.theta_max))
+    return reject(why, "theta_max [rad]", p.theta_max, "above theta_min", p.theta_min);
+  if (!(p.phi_min > -limit && p.phi_min < limit))
+    return reject(why, "phi_min [rad]", p.phi_min, "(-pi/2, pi/2)");
+  if (!(p.phi_max > -limit && p.phi_max < limit))
+    return reject(why, "phi_max [rad]", p.phi_max, "(-pi/2, pi/2)");
+  if (!(p.phi_min < p.phi_max))
+    return reject(why, "phi_max [rad]", p.phi_max, "above phi_min", p.phi_min);
   return true;
 }
 
@@ -559,7 +604,7 @@ SensorParameters::validate(std::string* why) const
   if (!validateWindow(*this, why))
     return false;
   if (num_rays < 1 || num_rays > 100000000)
-    return reject(why, "num_rays", static_cast<double>(num_rays), "[1, 1e8]");
+    return reject(why, "num_rays", static_cast<double>(num_rays), "[1, 100000000]");
   if (!inRange(density_ratio, 1.0, 100.0))
     return reject(why, "density_ratio", density_ratio, "[1, 100]");
   if (!inRange(texture_cycles, 0.0, 20.0) || texture_cycles == 0.0)
@@ -576,8 +621,8 @@ SensorParameters::validate(std::string* why) const
     return reject(why, "range_noise [1/m]", range_noise, "[0, 1]");
   if (!std::isfinite(min_range) || min_range < 0.0)
     return reject(why, "min_range [m]", min_range, ">= 0");
-  if (!std::isfinite(max_range) || !(max_range > min_range))
-    return reject(why, "max_range [m]", max_range, "(min_range, inf)");
+  if (!(max_range > min_range && max_range <= kMaxSimulatedRange))
+    return reject(why, "max_range [m]", max_range, "(min_range, 1e30]");
   return true;
 }
 
@@ -696,8 +741,17 @@ SensorSimulator::sampleDirections(SimulationDetails& details) const
   const double width = params_.theta_max - params_.theta_min;
   const double height = params_.phi_max - params_.phi_min;
   const double cells = static_cast<double>(params_.num_rays) / mean_density_;
-  const long columns = std::max(1L, std::lround(std::sqrt(cells * width / height)));
-  const long rows = std::max(1L, std::lround(cells / columns));
+  // About sqrt(cells) columns and rows in the window's aspect ratio. A window much
+  // wider than tall (or the reverse) has fewer rows than one: the columns are then
+  // capped at the cells, and when rounding the rows misses the cells by more than 5%
+  // (a window a row or two high) the columns are made again from the rows, so that
+  // there are always about num_rays / mean density candidates.
+  const long most = std::max(1L, std::lround(cells));
+  long columns = std::clamp(std::lround(std::sqrt(cells * width / height)), 1L, most);
+  const long rows =
+      std::clamp(std::lround(cells / static_cast<double>(columns)), 1L, most);
+  if (std::abs(static_cast<double>(rows * columns) - cells) > 0.05 * cells)
+    columns = std::clamp(std::lround(cells / static_cast<double>(rows)), 1L, most);
   const double cell_width = width / columns;
   const double cell_height = height / rows;
   std::mt19937 engine = makeEngine(params_.seed, kGridStream);
@@ -735,6 +789,10 @@ SensorSimulator::castOne(const Scene& scene,
     ++details.missed;
     return;
   }
+  if (hit.label == 0) { // a height field's label function broke its contract
+    ++details.unlabeled_hits;
+    return;
+  }
   const double sigma = params_.range_noise * hit.range * hit.range;
   const double measured = hit.range + sigma * noise_deviate;
   if (!(measured >= params_.min_range && measured <= params_.max_range)) {
@@ -750,6 +808,29 @@ SensorSimulator::castOne(const Scene& scene,
   cloud.push_back(point);
   details.exact_ranges.push_back(hit.range);
 }
+
+namespace {
+
+/** True when no hit had label 0; otherwise an error, and the cloud emptied. */
+bool
+unlabeledHitsRefused(const SimulationDetails& d,
+                     pcl::PointCloud<pcl::PointXYZL>& cloud,
+                     const char* method)
+{
+  if (d.unlabeled_hits == 0)
+    return true;
+  PCL_ERROR(
+      "[pcl::selective_seg::simulation::SensorSimulator::%s] %zu hits on a height "
+      "field whose label function gave 0 (labels are >= 1): no point returned\n",
+      method,
+      d.unlabeled_hits);
+  cloud.clear();
+  cloud.width = 0;
+  cloud.height = 1;
+  return false;
+}
+
+} // namespace
 
 bool
 SensorSimulator::simulate(const Scene& scene,
@@ -780,6 +861,8 @@ SensorSimulator::simulate(const Scene& scene,
     else
       castOne(scene, angles, deviate, cloud, d);
   }
+  if (!unlabeledHitsRefused(d, cloud, "simulate"))
+    return false;
   cloud.width = static_cast<std::uint32_t>(cloud.size());
   cloud.height = 1;
   cloud.is_dense = true;
@@ -792,16 +875,17 @@ bool
 ScanWindow::validate(std::string* why) const
 {
   const double limit = 0.5 * kPi;
+  const auto bounds = [&](const char* name, double lo, double hi) {
+    std::ostringstream s;
+    s << std::setprecision(17) << "scan window " << name << "_min " << lo << ", "
+      << name << "_max " << hi << ": need -pi/2 < " << name << "_min < " << name
+      << "_max < pi/2 [rad]";
+    return fail(why, s.str());
+  };
   if (!(theta_min > -limit && theta_min < theta_max && theta_max < limit))
-    return fail(why,
-                "scan window theta_min " + std::to_string(theta_min) + ", theta_max " +
-                    std::to_string(theta_max) +
-                    ": need -pi/2 < theta_min < theta_max < pi/2 [rad]");
+    return bounds("theta", theta_min, theta_max);
   if (!(phi_min > -limit && phi_min < phi_max && phi_max < limit))
-    return fail(why,
-                "scan window phi_min " + std::to_string(phi_min) + ", phi_max " +
-                    std::to_string(phi_max) +
-                    ": need -pi/2 < phi_min < phi_max < pi/2 [rad]");
+    return bounds("phi", phi_min, phi_max);
   if (!(step > 0.0) || !std::isfinite(step))
     return reject(why, "scan window step", step, "(0, inf) [rad]");
   const double cells = std::ceil((theta_max - theta_min) / step + 0.5) *
@@ -869,6 +953,8 @@ SensorSimulator::simulateWindow(const Scene& scene,
                           castOne(scene, {theta, phi}, deviate, cloud, d);
                       });
   d.candidates = static_cast<std::size_t>(rows * columns);
+  if (!unlabeledHitsRefused(d, cloud, "simulateWindow"))
+    return false;
   cloud.width = static_cast<std::uint32_t>(cloud.size());
   cloud.height = 1;
   cloud.is_dense = true;
@@ -901,6 +987,12 @@ viewWindow(double theta_min,
   sensor.phi_max = phi_max;
   const double count = std::round(rays * (density > 0.0 ? density : 0.0));
   sensor.num_rays = static_cast<std::size_t>(std::clamp(count, 1.0, 1e8));
+  if (!(count >= 1.0 && count <= 1e8))
+    PCL_WARN("[pcl::selective_seg::simulation] scene density %g asks for %g rays; the "
+             "sensor casts %zu (the simulator's range is [1, 1e8])\n",
+             density,
+             rays * density,
+             sensor.num_rays);
   return sensor;
 }
 

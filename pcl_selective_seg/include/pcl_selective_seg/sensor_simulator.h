@@ -131,7 +131,10 @@ struct HeightField {
   HeightFunction height;
   /** \brief Label of each point of the panel. */
   LabelFunction label;
-  /** \brief Lower bound of \a height over the base [m]. */
+  /** \brief Lower bound of \a height over the base [m]. The rays search between the
+   * bounds only: a surface outside them is not seen. validateScene() checks \a height
+   * and \a label (>= 1) on a 17 x 17 grid of (s, t); a hit whose label is 0 elsewhere
+   * makes the simulation fail. */
   double min_height = 0.0;
   /** \brief Upper bound of \a height over the base [m], >= min_height. */
   double max_height = 0.0;
@@ -294,7 +297,7 @@ struct PCL_EXPORTS SensorParameters {
   double range_noise = 0.001;
   /** \brief Hits measured nearer than this give no point [m]. Valid: >= 0. */
   double min_range = 0.1;
-  /** \brief Hits measured farther than this give no point [m], > min_range. */
+  /** \brief Hits measured farther than this give no point [m], in (min_range, 1e30]. */
   double max_range = 10.0;
   /** \brief Seed of every random draw; equal parameters give identical clouds. */
   std::uint32_t seed = 42;
@@ -335,6 +338,9 @@ struct SimulationDetails {
   std::size_t missed = 0;
   /** \brief Hits whose measured range fell outside [min_range, max_range]. */
   std::size_t out_of_range = 0;
+  /** \brief Hits on a height field whose label function gave 0 there (a broken
+   * scene: the call then fails and returns no point). */
+  std::size_t unlabeled_hits = 0;
   /** \brief Noise-free range of each output point [m], in cloud order. */
   std::vector<double> exact_ranges;
 };
@@ -351,7 +357,10 @@ struct PCL_EXPORTS ScanWindow {
   /** \brief Largest vertical angle [rad], in (phi_min, pi/2). */
   double phi_max = 0.1;
   /** \brief Spacing of the candidate ray grid in both angles [rad], > 0; the grid has
-   * at most 1e8 cells. */
+   * at most 1e8 cells. The window is cut into round(width / step) columns and
+   * round(height / step) rows (at least one each), so the spacing is the window's
+   * width or height divided evenly: within a factor 1.5 of \a step for a window of
+   * at least one step, closer for a window of many. */
   double step = 0.01;
   /** \brief Mixed into the seed of the window's grid, dropout and noise streams, so
    * that repeated scans of one window (or overlapping windows) draw new rays; equal
@@ -529,8 +538,9 @@ enum class DoorLabel : std::uint32_t {
  * that exactly three faces (top, right, front) are seen; only those are modelled
  * (FaceSelection::FacingOrigin). Labels: CubeLabel.
  *
- * \param[in] density multiplier of the ray count (> 0); 1 gives about the paper's
- *            5,432 points with the default sensor model.
+ * \param[in] density multiplier of the ray count (> 0; one that asks for fewer than 1
+ *            or more than 1e8 rays gives 1 or 1e8, with a warning); 1 gives about the
+ *            paper's 5,432 points with the default sensor model.
  * \return the scene and the sensor (view window theta in [-0.35, 0.35], phi in
  *         [0.05, 0.9] rad). */
 PCL_EXPORTS SimulationSetup makeCubeScene(double density = 1.0);
@@ -543,8 +553,9 @@ PCL_EXPORTS SimulationSetup makeCubeScene(double density = 1.0);
  * the sensor is 1.5 m above the floor, 1.8 m in front of the seat's centre. Only the
  * faces turned toward the sensor are modelled; each is its own label (ChairLabel).
  *
- * \param[in] density multiplier of the ray count (> 0); 1 gives about the paper's
- *            1,544 points with the default sensor model.
+ * \param[in] density multiplier of the ray count (> 0; one that asks for fewer than 1
+ *            or more than 1e8 rays gives 1 or 1e8, with a warning); 1 gives about the
+ *            paper's 1,544 points with the default sensor model.
  * \return the scene and the sensor. */
 PCL_EXPORTS SimulationSetup makeChairScene(double density = 1.0);
 
@@ -560,8 +571,9 @@ PCL_EXPORTS SimulationSetup makeChairScene(double density = 1.0);
  * front of the skin; its cap nearer the sensor's axis is seen at about 18 degrees.
  * Labels: DoorLabel.
  *
- * \param[in] density multiplier of the ray count (> 0); 1 gives about the paper's
- *            46,255 points with the default sensor model.
+ * \param[in] density multiplier of the ray count (> 0; one that asks for fewer than 1
+ *            or more than 1e8 rays gives 1 or 1e8, with a warning); 1 gives about the
+ *            paper's 46,255 points with the default sensor model.
  * \return the scene and the sensor. */
 PCL_EXPORTS SimulationSetup makeDoorScene(double density = 1.0);
 
