@@ -86,7 +86,8 @@ printHelp(const char* program)
       "(made if missing)\n"
       "  -scenes a,b            scenes among cube, chair, door (default all three)\n"
       "  -iterations N          refinement rounds (default %d)\n"
-      "  -coarse_factor X       coarse step = X times the fine step (default %g)\n"
+      "  -coarse_factor X       coarse step = X times the fine step, in [1, 100] "
+      "(default %g)\n"
       "  -budget_fraction F     selective point budget, fraction of the finest uniform "
       "scan's points (default %g)\n"
       "  -range_noise K         range noise sigma = K r^2 [1/m] (default %g, "
@@ -95,14 +96,16 @@ printHelp(const char* program)
       "automatic from the coarse scan (default %g)\n"
       "  -progressive 0|1       1: each round a step finer, the last at the fine "
       "step; 0: every round at the fine step (default %g)\n"
-      "  -window_steps X        evidence tiles of X coarse steps; 0 = "
+      "  -window_steps X        evidence tiles of X coarse steps, in [0.01, 1000]; 0 = "
       "-roi_max_window_deg (default %g)\n"
       "  -step_scale S          multiply every step by S (S > 1: a quicker, coarser "
       "run; default %g)\n"
       "  -seed N                the sensor's random seed (rays, dropouts, noise) for "
       "every scan; default: the scene's own\n\n"
       "The loop sets the regions' step (the fine step), point budget and yield; the "
-      "other\nregion options apply (the budget flags are ignored). The loop's own "
+      "other\nregion options apply (the budget flags -roi_max_points, -roi_max_sr and "
+      "-roi_max_regions\nare refused: -budget_fraction sets the budget). The loop's "
+      "own "
       "defaults differ from those\nlisted below: -roi_margin_spacings 0.5 "
       "-roi_valid_edges 1 -roi_edge_on 1 -roi_side_deg 25 -roi_side_confidence 0.95\n"
       "-roi_sparse_by_area 1:\n",
@@ -163,9 +166,25 @@ parseOptions(int argc, char** argv, Options& opt)
         print_error("Unknown scene '%s': use cube, chair or door.\n", name.c_str());
         return false;
       }
+      if (std::find(opt.scenes.begin(), opt.scenes.end(), name) != opt.scenes.end()) {
+        print_error("Scene '%s' is listed twice in -scenes.\n", name.c_str());
+        return false;
+      }
       opt.scenes.push_back(name);
     }
+    if (opt.scenes.empty()) {
+      print_error("-scenes needs at least one of cube, chair, door.\n");
+      return false;
+    }
   }
+  for (const char* flag : {"-roi_max_points", "-roi_max_sr", "-roi_max_regions"})
+    if (find_argument(argc, argv, flag) >= 0) {
+      print_error(
+          "%s does not apply here: the loop's budget is -budget_fraction of the "
+          "finest uniform scan's points.\n",
+          flag);
+      return false;
+    }
   using selseg_apps::parseNumber;
   if (!parseNumber(argc, argv, "-iterations", opt.iterations) ||
       !parseNumber(argc, argv, "-coarse_factor", opt.coarse_factor) ||
@@ -184,17 +203,21 @@ parseOptions(int argc, char** argv, Options& opt)
                 "-min_voxel_factor, the uniform scans choose theirs.\n");
     return false;
   }
-  if (opt.iterations < 0 || opt.iterations > 100 || !(opt.coarse_factor >= 1.0) ||
+  if (opt.iterations < 0 || opt.iterations > 100 ||
+      !(opt.coarse_factor >= 1.0 && opt.coarse_factor <= 100.0) ||
       !(opt.budget_fraction > 0.0 && opt.budget_fraction <= 1.0) ||
       !(opt.range_noise >= 0.0 && opt.range_noise <= 1.0) ||
       !(opt.min_voxel_factor >= 0.0) || !(opt.step_scale > 0.0) ||
-      !(opt.window_steps >= 0.0) ||
+      !(opt.window_steps == 0.0 ||
+        (opt.window_steps >= 0.01 && opt.window_steps <= 1000.0)) ||
       (opt.progressive != 0.0 && opt.progressive != 1.0) ||
       !(opt.seed < 0.0 ||
         (opt.seed <= 4294967295.0 && opt.seed == std::floor(opt.seed)))) {
-    print_error("Need 0 <= iterations <= 100, coarse_factor >= 1, 0 < budget_fraction "
-                "<= 1, 0 <= range_noise <= 1, min_voxel_factor >= 0, step_scale > 0, "
-                "window_steps >= 0, progressive 0 or 1, seed a whole number < 2^32.\n");
+    print_error(
+        "Need 0 <= iterations <= 100, 1 <= coarse_factor <= 100, 0 < "
+        "budget_fraction <= 1, 0 <= range_noise <= 1, min_voxel_factor >= 0, "
+        "step_scale > 0, window_steps 0 or in [0.01, 1000], progressive 0 or 1, "
+        "seed a whole number < 2^32.\n");
     return false;
   }
   return true;
@@ -261,17 +284,12 @@ savePcd(selseg_apps::OutputTransaction& outputs,
   return ok;
 }
 
-/** The smallest fraction of \a points that is at least one point, rounded up to three
- * digits. */
+/** \a fraction rounded up to three significant digits. */
 double
-smallestFraction(std::size_t points)
+roundUp3(double fraction)
 {
-  const double n = static_cast<double>(points);
-  const double unit = std::pow(10.0, std::floor(std::log10(1.0 / n)) - 2.0);
-  double f = std::ceil(1.0 / n / unit) * unit;
-  while (static_cast<std::size_t>(f * n) < 1)
-    f += unit;
-  return f;
+  const double unit = std::pow(10.0, std::floor(std::log10(fraction)) - 2.0);
+  return std::ceil(fraction / unit - 1e-9) * unit;
 }
 
 /** Run one scene; appends its rows to \a table and stages its files in \a outputs. */
@@ -328,14 +346,20 @@ runScene(const Options& opt,
   loop.progressive = opt.progressive == 1.0;
   loop.point_budget =
       static_cast<std::size_t>(opt.budget_fraction * static_cast<double>(dense_points));
-  if (loop.point_budget == 0) {
-    // Whether a fraction is too small depends on the scene's point count.
+  // The budget includes the coarse scan, about 1 / coarse_factor^2 of the finest
+  // uniform scan's points (whether a fraction is too small depends on the scene).
+  const double coarse_share = 1.0 / (opt.coarse_factor * opt.coarse_factor);
+  if (static_cast<double>(loop.point_budget) <
+      coarse_share * static_cast<double>(dense_points)) {
     print_error("%s: -budget_fraction %g of the finest uniform scan's %zu points is a "
-                "budget of 0 points: give -budget_fraction %.3g or more.\n",
+                "budget of %zu points, less than the coarse scan's (about %.0f): give "
+                "-budget_fraction %.3g or more.\n",
                 name.c_str(),
                 opt.budget_fraction,
                 dense_points,
-                smallestFraction(dense_points));
+                loop.point_budget,
+                coarse_share * static_cast<double>(dense_points),
+                roundUp3(1.25 * coarse_share));
     return false;
   }
   std::vector<RegionOfInterest> scanned;

@@ -11,9 +11,14 @@ here=$(cd "$(dirname "$0")" && pwd)
 build=${1:?usage: $0 BUILD_DIR [OUT_DIR] [IMAGES_DIR]}
 out=${2:-selective}
 images=${3:-$here/../docs/images}
+loop_tool="$build/apps/pcl_selective_seg_selective_loop"
+if [ ! -x "$loop_tool" ]; then
+  echo "$0: no $loop_tool: give the build folder of a built checkout" >&2
+  exit 2
+fi
 mkdir -p "$out" "$images"
 
-"$build/apps/pcl_selective_seg_selective_loop" -out "$out" | tee "$out/log.txt"
+"$loop_tool" -out "$out" | tee "$out/log.txt"
 
 # One run is one draw of the sensor's random streams (rays, dropouts, noise, texture):
 # the same on 31 other seeds, summarized in OUT/seeds.md (final round against the
@@ -22,14 +27,16 @@ mkdir -p "$out" "$images"
 seeds="$(seq -s " " 1 31)"
 for seed in $seeds; do
   mkdir -p "$out/seed_$seed"
-  "$build/apps/pcl_selective_seg_selective_loop" -out "$out/seed_$seed" -seed "$seed" \
+  "$loop_tool" -out "$out/seed_$seed" -seed "$seed" \
     > "$out/seed_$seed/log.txt"
 done
 {
   echo "| scene | seed | finest uniform: points, accuracy (mm) | selective: points, accuracy (mm) | ratio |"
   echo "|---|---|---|---|---|"
   for scene in cube chair door; do
-    for dir in "$out" $(for seed in $seeds; do echo "$out/seed_$seed"; done); do
+    dirs=("$out")
+    for seed in $seeds; do dirs+=("$out/seed_$seed"); done
+    for dir in "${dirs[@]}"; do
       seed=42
       [ "$dir" = "$out" ] || seed=${dir##*seed_}
       awk -F'|' -v scene="$scene" -v seed="$seed" '
@@ -84,8 +91,8 @@ set grid
 set key top right
 do for [scene in "cube chair door"] {
   file = "$out/".scene.".dat"
-  dense_points = system("awk '!/^#/ && NF {p=\$1} /^# selective/ {exit} END {print p}' ".file)
-  dense_acc = system("awk '!/^#/ && NF {a=\$3} /^# selective/ {exit} END {print a*1000}' ".file)
+  dense_points = system("awk '!/^#/ && NF {p=\$1} /^# selective/ {exit} END {print p}' \"".file."\"")
+  dense_acc = system("awk '!/^#/ && NF {a=\$3} /^# selective/ {exit} END {print a*1000}' \"".file."\"")
   set title scene
   set arrow 1 from dense_points*0.3/1000, graph 0 to dense_points*0.3/1000, graph 1 nohead dt 2 lc rgb "gray40"
   set arrow 2 from graph 0, first dense_acc*1.1 to graph 1, first dense_acc*1.1 nohead dt 3 lc rgb "gray40"

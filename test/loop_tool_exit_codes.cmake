@@ -30,6 +30,13 @@ expect(2 "Unknown argument '-bogus'" -bogus 1)
 expect(2 "Missing value of '-out'" -out)
 expect(2 "Give -out FOLDER" -scenes cube)
 expect(2 "Unknown scene 'sofa'" -out ${BLOCKED}.d -scenes sofa)
+expect(2 "Scene 'cube' is listed twice" -out ${BLOCKED}.d -scenes cube,cube)
+# The loop sets the regions' budget; these were once accepted and still applied.
+expect(2 "-roi_max_regions does not apply here" -out ${BLOCKED}.d -roi_max_regions 2)
+expect(2 "-roi_max_sr does not apply here" -out ${BLOCKED}.d -roi_max_sr 1e-5)
+# Out of range before any scan (these failed only after the uniform scans, exit 1).
+expect(2 "1 <= coarse_factor <= 100" -out ${BLOCKED}.d -coarse_factor 1e300)
+expect(2 "window_steps 0 or in" -out ${BLOCKED}.d -window_steps 1e-12)
 # A repeated option (the first value was used silently).
 expect(2 "Option -iterations is given more than once"
   -out ${BLOCKED}/out -iterations 1 -iterations 2 -scenes cube)
@@ -57,12 +64,14 @@ if(NOT left STREQUAL "chair.dat;cube.dat" OR NOT cube_dat STREQUAL "old\n")
   set(failures "${failures}\n  a failed run changed its folder: '${left}', cube.dat "
     "'${cube_dat}'")
 endif()
-# A budget fraction too small for the scene's points is a runtime error (it depends on
-# the scan) whose message gives the smallest fraction that works; the folder the run
-# made (and its parent) is removed. That fraction then runs.
+# A budget fraction too small for the coarse scan (which the budget includes) is a
+# runtime error (it depends on the scan) whose message gives a fraction that works;
+# the folder the run made (and its parent) is removed. That fraction then runs.
 set(fresh ${WORK}/fresh/out)
-expect(1 "budget of 0 points: give -budget_fraction [0-9.e+-]+ or more"
+expect(1 "budget of 0 points, less than the coarse scan's .*: give -budget_fraction [0-9.e+-]+ or more"
   -out ${fresh} -scenes cube -iterations 1 -budget_fraction 1e-300)
+expect(1 "budget of [0-9]+ points, less than the coarse scan's"
+  -out ${fresh} -scenes cube -iterations 1 -budget_fraction 0.05)
 if(EXISTS ${WORK}/fresh)
   set(failures "${failures}\n  a failed run left the folder it made")
 endif()

@@ -146,6 +146,69 @@ TEST(SelectiveLoop, BadParametersAreRejected)
   params = sim::SelectiveLoopParameters();
   params.point_budget = 0;
   EXPECT_FALSE(sim::runSelectiveLoop(cube(), params, reference, rounds));
+  params = sim::SelectiveLoopParameters();
+  params.iterations = 2001;
+  EXPECT_FALSE(sim::runSelectiveLoop(cube(), params, reference, rounds));
+}
+
+TEST(SelectiveLoop, BudgetBelowTheCoarseScanFails)
+{
+  // The budget includes the coarse scan: one that cannot hold it is refused, not
+  // silently overrun.
+  const auto setup = cube();
+  sim::ReferenceBoundary reference;
+  ASSERT_TRUE(sim::makeReferenceBoundary(setup, 0.01, reference));
+  sim::SelectiveLoopParameters params;
+  params.fine_step = 0.0045;
+  params.point_budget = 100;
+  std::vector<sim::ScanScore> rounds;
+  EXPECT_FALSE(sim::runSelectiveLoop(setup, params, reference, rounds));
+  EXPECT_TRUE(rounds.empty());
+}
+
+TEST(SelectiveLoop, WindowsStayInTheViewAndTheBudgetIsUsed)
+{
+  // Many rounds with a small budget: each round's share is small, and windows at the
+  // view's border have margins that reach past it.
+  const auto setup = cube();
+  const double fine = 0.0045;
+  sim::ReferenceBoundary reference;
+  ASSERT_TRUE(sim::makeReferenceBoundary(setup, 0.5 * fine, reference));
+  sim::SelectiveLoopParameters params;
+  params.fine_step = fine;
+  params.iterations = 30;
+  params.point_budget = 4000;
+  std::vector<sim::ScanScore> rounds;
+  const pcl::PointCloud<pcl::PointXYZL>* last = nullptr;
+  std::size_t windows = 0;
+  ASSERT_TRUE(sim::runSelectiveLoop(
+      setup, params, reference, rounds, [&](const sim::LoopRound& r) {
+        last = r.cloud;
+        for (const auto& w : *r.regions) {
+          ++windows;
+          EXPECT_GE(w.theta_min, setup.sensor.theta_min);
+          EXPECT_LE(w.theta_max, setup.sensor.theta_max);
+          EXPECT_GE(w.phi_min, setup.sensor.phi_min);
+          EXPECT_LE(w.phi_max, setup.sensor.phi_max);
+        }
+      }));
+  ASSERT_NE(last, nullptr);
+  EXPECT_GT(windows, 0u);
+  // Every point acquired lies in the view (up to the float rounding of its angles).
+  std::size_t outside = 0;
+  for (const auto& p : *last) {
+    const double theta = std::atan2(p.x, p.z);
+    const double phi = std::atan2(p.y, p.z);
+    if (theta < setup.sensor.theta_min - 1e-6 ||
+        theta > setup.sensor.theta_max + 1e-6 || phi < setup.sensor.phi_min - 1e-6 ||
+        phi > setup.sensor.phi_max + 1e-6)
+      ++outside;
+  }
+  EXPECT_EQ(outside, 0u);
+  // A round whose share fits no window leaves it to the next: the loop goes on until
+  // the budget is nearly used, and overruns it by one window's error at most.
+  EXPECT_GE(rounds.back().points, params.point_budget * 9 / 10);
+  EXPECT_LE(rounds.back().points, params.point_budget * 105 / 100);
 }
 
 // A draw of the cube's sensor (seed 6) whose coarse segmentation merges the cube's top

@@ -24,7 +24,35 @@ namespace {
 constexpr std::uint32_t kReferenceScan = 0x7fffffffu;
 constexpr std::uint32_t kUniformScan = 1;
 constexpr std::uint32_t kCoarseScan = 2;
-constexpr std::uint32_t kRoundScans = 1000; ///< round r, window k: r * 1000 + k
+/** Window k of round r is scan (r + 1) * 2^20 + k: distinct for fewer than 2^20
+ * windows a round (the loop scans no more) and kMaxIterations rounds, and below
+ * kReferenceScan. */
+constexpr int kRoundScanBits = 20;
+constexpr std::size_t kMaxWindowsPerRound = std::size_t{1} << kRoundScanBits;
+constexpr int kMaxIterations = 2000;
+static_assert((std::uint64_t{kMaxIterations + 1} << kRoundScanBits) +
+                      kMaxWindowsPerRound <
+                  kReferenceScan,
+              "round scan ids must stay below the reference scan's");
+
+/** The part of a window inside the sensor's view, its solid angle and point estimate
+ * scaled to that part; false when nothing of it is inside. */
+bool
+clipToView(const SensorParameters& view, RegionOfInterest& r)
+{
+  const double before = r.solid_angle;
+  r.theta_min = std::max(r.theta_min, view.theta_min);
+  r.theta_max = std::min(r.theta_max, view.theta_max);
+  r.phi_min = std::max(r.phi_min, view.phi_min);
+  r.phi_max = std::min(r.phi_max, view.phi_max);
+  if (!(r.theta_min < r.theta_max && r.phi_min < r.phi_max))
+    return false;
+  r.solid_angle = windowSolidAngle(r.theta_min, r.theta_max, r.phi_min, r.phi_max);
+  if (before > 0.0 && r.solid_angle < before)
+    r.estimated_points = static_cast<std::size_t>(
+        std::ceil(static_cast<double>(r.estimated_points) * r.solid_angle / before));
+  return true;
+}
 
 ScanWindow
 viewOf(const SensorParameters& sensor, double step, std::uint32_t scan_id)
@@ -217,11 +245,12 @@ runSelectiveLoop(const SimulationSetup& setup,
   rounds.clear();
   if (!(params.fine_step > 0.0) || !std::isfinite(params.fine_step) ||
       !(params.coarse_factor >= 1.0) || !std::isfinite(params.coarse_factor) ||
-      params.iterations < 0 || params.point_budget == 0 ||
-      !(params.min_voxel_factor >= 0.0) || !(params.boundary_edge_steps > 0.0) ||
-      !(params.window_steps >= 0.0) || !std::isfinite(params.window_steps))
+      params.iterations < 0 || params.iterations > kMaxIterations ||
+      params.point_budget == 0 || !(params.min_voxel_factor >= 0.0) ||
+      !(params.boundary_edge_steps > 0.0) || !(params.window_steps >= 0.0) ||
+      !std::isfinite(params.window_steps))
     return fail("invalid parameters: need fine_step > 0 [rad], coarse_factor >= 1, "
-                "iterations >= 0, point_budget > 0, min_voxel_factor >= 0, "
+                "0 <= iterations <= 2000, point_budget > 0, min_voxel_factor >= 0, "
                 "boundary_edge_steps > 0, window_steps >= 0");
   SensorSimulator simulator;
   if (!simulator.setParameters(setup.sensor))
@@ -237,11 +266,24 @@ runSelectiveLoop(const SimulationSetup& setup,
     return fail("the coarse scan failed (reason above)");
   if (cloud->empty())
     return fail("the coarse scan has no point");
+  if (cloud->size() > params.point_budget) {
+    PCL_ERROR(
+        "[pcl::selective_seg::simulation::runSelectiveLoop] the coarse scan's %zu "
+        "points exceed the point budget of %zu, which includes them: give a "
+        "larger budget or a larger coarse_factor\n",
+        cloud->size(),
+        params.point_budget);
+    return false;
+  }
+  // Points per candidate ray: from the coarse scan, then from every window scanned so
+  // far (their points over their estimates at yield 1).
   double yield =
       std::clamp(static_cast<double>(cloud->size()) /
                      static_cast<double>(std::max<std::size_t>(details.candidates, 1)),
                  1e-3,
                  1.0);
+  double window_points = 0.0;
+  double window_candidates = 0.0;
 
   SelectiveSegmentation<pcl::PointXYZL> seg;
   seg.setParameters(params.segmentation);
@@ -291,30 +333,41 @@ runSelectiveLoop(const SimulationSetup& setup,
         return fail("computing the regions of interest failed (reason above)");
       score.seconds += watch.getTimeSeconds();
     }
-    // Windows in priority order while the points actually acquired leave room for the
-    // window's estimate: the budget holds up to one window's estimation error.
+    // Windows in priority order, clipped to the sensor's view (a window's margins may
+    // reach past it, where the uniform scans see nothing), while the points actually
+    // acquired leave room for the window's estimate (at least one point): the budget
+    // holds up to one window's estimation error.
     pcl::PointCloud<pcl::PointXYZL> fresh;
     std::vector<RegionOfInterest> scanned;
     double solid_angle = 0.0;
-    for (std::size_t k = 0; k < regions.size(); ++k) {
-      const auto& r = regions[k];
+    double estimated = 0.0;
+    for (std::size_t k = 0; k < regions.size() && scanned.size() < kMaxWindowsPerRound;
+         ++k) {
+      RegionOfInterest r = regions[k];
+      if (!clipToView(setup.sensor, r))
+        continue;
+      r.estimated_points = std::max<std::size_t>(r.estimated_points, 1);
       const std::size_t acquired = cloud->size() + fresh.size();
       if (acquired + r.estimated_points > params.point_budget)
         continue;
+      const std::size_t index = scanned.size();
       scanned.push_back(r);
+      estimated += static_cast<double>(r.estimated_points);
       ScanWindow w;
       w.theta_min = r.theta_min;
       w.theta_max = r.theta_max;
       w.phi_min = r.phi_min;
       w.phi_max = r.phi_max;
       w.step = r.suggested_step;
-      w.scan_id = static_cast<std::uint32_t>((round + 1) * kRoundScans + k);
+      w.scan_id = static_cast<std::uint32_t>(
+          (static_cast<std::uint64_t>(round + 1) << kRoundScanBits) + index);
       pcl::PointCloud<pcl::PointXYZL> part;
       if (!simulator.simulateWindow(setup.scene, w, part))
         return fail("a window scan failed (reason above)");
       fresh += part;
       solid_angle += r.solid_angle;
     }
+    const bool no_candidates = regions.empty();
     regions = scanned;
     rounds.push_back(score);
     if (observer) {
@@ -327,18 +380,18 @@ runSelectiveLoop(const SimulationSetup& setup,
       r.score = score;
       observer(r);
     }
-    if (scanned.empty())
-      break;
+    if (scanned.empty()) {
+      // Nothing to refine, or the last round: done. Otherwise this round's share of
+      // the budget fitted no window; the next round's share is larger.
+      if (no_candidates || round >= params.iterations)
+        break;
+      continue;
+    }
     score.windows = scanned.size();
     score.scanned_solid_angle += solid_angle;
-    std::size_t estimated = 0;
-    for (const auto& r : scanned)
-      estimated += r.estimated_points;
-    if (estimated > 0)
-      yield = std::clamp(yield * static_cast<double>(fresh.size()) /
-                             static_cast<double>(estimated),
-                         1e-3,
-                         1.0);
+    window_points += static_cast<double>(fresh.size());
+    window_candidates += estimated / yield;
+    yield = std::clamp(window_points / window_candidates, 1e-3, 1.0);
     fresh.width = static_cast<std::uint32_t>(fresh.size());
     fresh.height = 1;
     if (!seg.update(fresh, clusters))

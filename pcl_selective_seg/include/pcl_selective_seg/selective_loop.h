@@ -94,14 +94,16 @@ struct PCL_EXPORTS SelectiveLoopParameters {
   double fine_step = 0.004;
   /** \brief The coarse scan's step is this many times fine_step, >= 1. */
   double coarse_factor = 3.0;
-  /** \brief Refinement rounds (ROI, scan, update), >= 0. */
+  /** \brief Refinement rounds (ROI, scan, update), in [0, 2000]. A round whose share
+   * of the budget fits no window scans nothing and leaves its share to the next. */
   int iterations = 3;
   /** \brief Each round a step finer: round r of n targets coarse_step x (fine_step /
    * coarse_step)^(r / n), the last fine_step (a round confirms and narrows the
    * transitions the previous one found). false: every round targets fine_step. */
   bool progressive = true;
-  /** \brief Points the whole loop may acquire, the coarse scan included, > 0; each
-   * round may use the remaining budget divided by the remaining rounds. */
+  /** \brief Points the whole loop may acquire, the coarse scan included, > 0 (a coarse
+   * scan with more points fails the loop); each round may use the remaining budget
+   * divided by the remaining rounds. */
   std::size_t point_budget = 10000;
   /** \brief Finest octree voxel: this many times fine_step times the coarse scan's
    * median range [m] (the automatic size of a scan at fine_step); 0: the automatic
@@ -117,8 +119,9 @@ struct PCL_EXPORTS SelectiveLoopParameters {
   double window_steps = 1.0;
   SelectiveSegmentationParameters segmentation;
   /** \brief The regions of interest; target_step, max_points and sample_yield are set
-   * by the loop (the yield from the coarse scan, then corrected each round by the
-   * points a round's windows actually returned over their estimate). */
+   * by the loop (the yield from the coarse scan, then the points all windows scanned
+   * so far returned over their candidate rays). The windows are clipped to the
+   * sensor's view before they are scanned, their estimates scaled to what is left. */
   RegionOfInterestParameters regions = loopRegionParameters();
 };
 
