@@ -251,7 +251,9 @@ struct BoundaryRecall {
  * \param[in] predicted \#N predicted labels, 0 = unlabeled
  * \param[in] ground_truth \#N GT labels, 0 = invalid (ignored)
  * \param[in] radius neighbourhood radius r of both boundaries [m], > 0
- * \param[in] match_distance largest GT-to-predicted boundary distance d [m], >= 0
+ * \param[in] match_distance largest GT-to-predicted boundary distance d [m], >= 0;
+ *            distances are those of the stored float coordinates (two points 0.01 apart
+ *            on a 0.01 grid may be 0.0100000016 apart)
  * \param[out] result counts and recall; zero on failure
  * \return false (with PCL_ERROR) on a size mismatch or a bad distance
  */
@@ -302,8 +304,9 @@ PCL_EXPORTS bool objectMetrics(const pcl::PointCloud<pcl::PointXYZ>& cloud,
  * A boundary edge is a mesh edge (a side of a triangle) whose two end points both have
  * finite coordinates, have different labels, at least one of them nonzero, and subtend
  * at most \a max_edge_angle at the sensor (the angle between the two rays from
- * \a sensor_origin; this leaves out the long edges across holes and sparse regions).
- * Its boundary point is the end point nearer to the sensor (on a ties the smaller
+ * \a sensor_origin; this leaves out the long edges across holes and sparse regions;
+ * an edge with an end point at the sensor origin has no such angle and is left out).
+ * Its boundary point is the end point nearer to the sensor (on a tie the smaller
  * index): at a depth jump that is the point on the occluding contour, at a crease a
  * point on one of the two faces. The result lists each boundary point once.
  *
