@@ -608,6 +608,91 @@ TEST(MeshNormals, VertexSumsEqualTheGatheredOnesToTheBit)
   }
 }
 
+TEST(MeshNormals, EmptyMeshes)
+{
+  // A mesh without triangles is a valid result (delaunay2d() on fewer than three or
+  // collinear points, SphericalDelaunay on a single row): every vertex gets the values
+  // of a vertex without a valid triangle, NaN normal and zero area, and every per
+  // triangle output is empty.
+  using namespace pcl::selective_seg;
+  const std::vector<Triangle> none;
+  const Vector3fVector no_normals;
+  const std::vector<double> no_areas;
+  for (const std::size_t num_vertices : {0u, 1u, 10u}) {
+    const Vector3fVector positions(num_vertices, Eigen::Vector3f(0.f, 0.f, 1.f));
+    for (const int threads : {1, 2}) {
+      for (const bool with_adjacency : {false, true}) {
+        Vector3fVector vertex_normals{Eigen::Vector3f::Zero()};
+        std::vector<double> vertex_areas{1.0};
+        computeVertexNormals(num_vertices,
+                             none,
+                             no_normals,
+                             no_areas,
+                             vertex_normals,
+                             vertex_areas,
+                             threads,
+                             with_adjacency ? &none : nullptr);
+        ASSERT_EQ(vertex_normals.size(), num_vertices);
+        ASSERT_EQ(vertex_areas.size(), num_vertices);
+        for (std::size_t v = 0; v < num_vertices; ++v) {
+          EXPECT_TRUE(vertex_normals[v].array().isNaN().all()) << v;
+          EXPECT_EQ(vertex_areas[v], 0.0) << v;
+        }
+      }
+      Vector3fVector normals{Eigen::Vector3f::Zero()};
+      std::vector<double> areas{1.0};
+      std::vector<std::uint8_t> edge_on{1};
+      computeTriangleNormals(
+          positions, none, Eigen::Vector3f::Zero(), normals, areas, threads);
+      EXPECT_TRUE(normals.empty());
+      EXPECT_TRUE(areas.empty());
+      computeTriangleNormalsAndEdgeOn(positions,
+                                      none,
+                                      Eigen::Vector3f::Zero(),
+                                      1.0,
+                                      normals,
+                                      areas,
+                                      edge_on,
+                                      threads);
+      EXPECT_TRUE(normals.empty());
+      EXPECT_TRUE(edge_on.empty());
+      markEdgeOnTriangles(
+          positions, none, no_normals, Eigen::Vector3f::Zero(), 1.0, edge_on, threads);
+      EXPECT_TRUE(edge_on.empty());
+      updateTriangleNormalsAndEdgeOn(positions,
+                                     none,
+                                     Eigen::Vector3f::Zero(),
+                                     1.0,
+                                     {},
+                                     {},
+                                     normals,
+                                     areas,
+                                     edge_on,
+                                     threads);
+      EXPECT_TRUE(normals.empty());
+      EXPECT_TRUE(areas.empty());
+      EXPECT_TRUE(edge_on.empty());
+      EXPECT_EQ(medianEdgeLength(positions, none, threads), 0.0);
+    }
+    Vector3fVector ring_normals;
+    computeVertexNormalsOverRings(
+        num_vertices, none, no_normals, no_areas, 2, ring_normals);
+    ASSERT_EQ(ring_normals.size(), num_vertices);
+    for (const auto& n : ring_normals)
+      EXPECT_TRUE(n.array().isNaN().all());
+    Vector3fVector from_vertices{Eigen::Vector3f::Zero()};
+    computeTriangleNormalsFromVertices(none, ring_normals, from_vertices);
+    EXPECT_TRUE(from_vertices.empty());
+    // Nothing changed: the vertex values stay as they are.
+    Vector3fVector kept(num_vertices, Eigen::Vector3f(0.f, 0.f, -1.f));
+    std::vector<double> kept_areas(num_vertices, 2.0);
+    updateVertexNormals(none, none, no_normals, no_areas, {}, kept, kept_areas);
+    updateVertexNormalsOverRings(none, none, no_normals, no_areas, 2, {}, kept);
+    EXPECT_EQ(kept, Vector3fVector(num_vertices, Eigen::Vector3f(0.f, 0.f, -1.f)));
+    EXPECT_EQ(kept_areas, std::vector<double>(num_vertices, 2.0));
+  }
+}
+
 int
 main(int argc, char** argv)
 {

@@ -338,8 +338,10 @@ scatterVertexNormals(std::size_t num_vertices,
   if (parallel && !neighbours)
     return false; // the gather runs on all threads
   const auto runs = static_cast<std::size_t>(parallel ? num_threads : 1);
-  std::vector<pcl::index_t> run_lowest(runs + 1);
-  for (std::size_t c = 0; c < runs; ++c)
+  // Only the bounds between runs are read: a mesh without triangles (one run) has no
+  // triangle to look at.
+  std::vector<pcl::index_t> run_lowest(runs + 1, 0);
+  for (std::size_t c = 1; c < runs; ++c)
     run_lowest[c] = lowestVertex(triangles[c * num_triangles / runs]);
   run_lowest[runs] = static_cast<pcl::index_t>(num_vertices);
   for (std::size_t c = 2; c < runs; ++c)
