@@ -693,6 +693,91 @@ TEST(MeshNormals, EmptyMeshes)
   }
 }
 
+TEST(MeshNormals, NonManifoldVertexSameForAnyThreadCount)
+{
+  // Two Delaunay patches glued at one vertex (a bow-tie: two separate fans of
+  // triangles around it), in canonical order and large enough to be split among
+  // threads. Walking the adjacency around the glued vertex covers one fan only; its
+  // normal and area must still sum both fans, as on one thread.
+  using namespace pcl::selective_seg;
+  std::mt19937 rng(3);
+  std::uniform_int_distribution<std::int32_t> coordinate(0, 99999);
+  std::vector<QuantizedPoint> angles;
+  while (angles.size() < 5000) {
+    angles.push_back({coordinate(rng), coordinate(rng)});
+    std::sort(angles.begin(), angles.end());
+    angles.erase(std::unique(angles.begin(), angles.end()), angles.end());
+  }
+  std::vector<Triangle> patch;
+  ASSERT_TRUE(delaunay2d(angles, DelaunayBackend::Sweep, patch));
+  const auto n = static_cast<pcl::index_t>(angles.size());
+  for (const pcl::index_t glued : {n / 2, n - 1}) {
+    // The second patch has its vertex 0 replaced by vertex `glued` of the first (its
+    // own vertex 0, id n, is left without triangles).
+    std::vector<Triangle> triangles = patch;
+    for (auto t : patch) {
+      for (auto& v : t)
+        v = v == 0 ? glued : v + n;
+      std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
+      triangles.push_back(t);
+    }
+    std::sort(triangles.begin(), triangles.end());
+    ASSERT_GE(triangles.size(), 2 * detail::kMinParallelItems);
+    Vector3fVector positions(2 * angles.size());
+    for (pcl::index_t i = 0; i < 2 * n; ++i) {
+      const auto& a = angles[i % n];
+      positions[i] =
+          Eigen::Vector3f(a[0] * 1e-5f, a[1] * 1e-5f, i < n ? 2.f : 2.f + a[0] * 1e-5f);
+    }
+    std::vector<Triangle> neighbours;
+    computeTriangleNeighbours(triangles, positions.size(), neighbours);
+    Vector3fVector normals;
+    std::vector<double> areas;
+    computeTriangleNormals(
+        positions, triangles, Eigen::Vector3f::Zero(), normals, areas);
+    // One thread: every vertex's triangles summed in increasing order.
+    Vector3fVector expected;
+    std::vector<double> expected_areas;
+    computeVertexNormals(positions.size(),
+                         triangles,
+                         normals,
+                         areas,
+                         expected,
+                         expected_areas,
+                         1,
+                         &neighbours);
+    double fans_area = 0.0;
+    for (std::size_t t = 0; t < triangles.size(); ++t)
+      if (std::count(triangles[t].begin(), triangles[t].end(), glued))
+        fans_area += areas[t];
+    EXPECT_NEAR(expected_areas[glued], fans_area, 1e-12 * fans_area);
+    for (const int threads : {2, 3, 4}) {
+      Vector3fVector computed;
+      std::vector<double> computed_areas;
+      computeVertexNormals(positions.size(),
+                           triangles,
+                           normals,
+                           areas,
+                           computed,
+                           computed_areas,
+                           threads,
+                           &neighbours);
+      ASSERT_EQ(computed.size(), expected.size());
+      EXPECT_EQ(std::memcmp(computed.data(),
+                            expected.data(),
+                            expected.size() * sizeof(Eigen::Vector3f)),
+                0)
+          << "glued vertex " << glued << ", " << threads
+          << " threads: " << computed[glued].transpose() << " instead of "
+          << expected[glued].transpose();
+      EXPECT_EQ(computed_areas, expected_areas)
+          << "glued vertex " << glued << ", " << threads
+          << " threads: " << computed_areas[glued] << " instead of "
+          << expected_areas[glued];
+    }
+  }
+}
+
 int
 main(int argc, char** argv)
 {

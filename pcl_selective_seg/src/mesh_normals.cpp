@@ -269,7 +269,10 @@ starOf(pcl::index_t v,
 
 /** Eq. 2-3 again at each vertex of \a seeds ((vertex, one of its triangles) pairs, a
  * vertex possibly listed several times), summed over its star in increasing order as
- * computeVertexNormals() sums it. */
+ * computeVertexNormals() sums it. With \a incidence (the number of triangle corners at
+ * each seed vertex), a vertex whose walked star holds fewer triangles (a vertex where
+ * separate fans meet, or a triangle with a repeated corner) is summed over its
+ * triangles found by one pass over the mesh instead. */
 void
 recomputeOverStars(std::vector<std::pair<pcl::index_t, pcl::index_t>>& seeds,
                    const std::vector<Triangle>& triangles,
@@ -278,7 +281,8 @@ recomputeOverStars(std::vector<std::pair<pcl::index_t, pcl::index_t>>& seeds,
                    const std::vector<double>& areas,
                    Vector3fVector& vertex_normals,
                    std::vector<double>& vertex_areas,
-                   int num_threads)
+                   int num_threads,
+                   const std::vector<pcl::index_t>* incidence = nullptr)
 {
   // Each vertex once, with the first triangle listed for it: the star and its sum do
   // not depend on the triangle the walk starts from (starOf() sorts the star).
@@ -293,20 +297,52 @@ recomputeOverStars(std::vector<std::pair<pcl::index_t, pcl::index_t>>& seeds,
     seeds.resize(kept);
   }
   const auto num_seeds = static_cast<std::ptrdiff_t>(seeds.size());
+  std::vector<std::uint8_t> partial(incidence ? seeds.size() : 0, 0);
 #pragma omp parallel num_threads(num_threads)
   {
     std::vector<pcl::index_t> star;
 #pragma omp for schedule(static)
     for (std::ptrdiff_t k = 0; k < num_seeds; ++k) {
-      starOf(seeds[k].first, seeds[k].second, triangles, neighbours, star);
+      const pcl::index_t v = seeds[k].first;
+      starOf(v, seeds[k].second, triangles, neighbours, star);
+      if (incidence && static_cast<std::size_t>((*incidence)[v]) != star.size()) {
+        partial[k] = 1;
+        continue;
+      }
       vertexNormal(star.data(),
                    star.data() + star.size(),
                    normals,
                    areas,
-                   vertex_normals[seeds[k].first],
-                   vertex_areas[seeds[k].first]);
+                   vertex_normals[v],
+                   vertex_areas[v]);
     }
   }
+  if (std::find(partial.begin(), partial.end(), 1) == partial.end())
+    return;
+  // The vertices the walk did not get around: their triangles, each listed once per
+  // corner at the vertex, in increasing order, from one pass over the mesh.
+  std::vector<pcl::index_t> slot(vertex_normals.size(), -1);
+  std::vector<std::vector<pcl::index_t>> lists;
+  for (std::size_t k = 0; k < seeds.size(); ++k)
+    if (partial[k]) {
+      slot[seeds[k].first] = static_cast<pcl::index_t>(lists.size());
+      lists.emplace_back();
+    }
+  for (std::size_t t = 0; t < triangles.size(); ++t)
+    for (const auto v : triangles[t])
+      if (slot[v] >= 0)
+        lists[slot[v]].push_back(static_cast<pcl::index_t>(t));
+  for (std::size_t k = 0; k < seeds.size(); ++k)
+    if (partial[k]) {
+      const pcl::index_t v = seeds[k].first;
+      const auto& list = lists[slot[v]];
+      vertexNormal(list.data(),
+                   list.data() + list.size(),
+                   normals,
+                   areas,
+                   vertex_normals[v],
+                   vertex_areas[v]);
+    }
 }
 
 /** computeVertexNormals() by adding each triangle's terms (eq. 2-3) to its vertices, in
@@ -314,15 +350,17 @@ recomputeOverStars(std::vector<std::pair<pcl::index_t, pcl::index_t>>& seeds,
  * vertex's triangles. On one thread that holds for any triangle order. With the
  * adjacency, the triangles are split into one run per thread: each thread adds straight
  * to the vertices it alone reaches, and a vertex that an earlier run also reaches is
- * left for the end, when its sum is redone over its whole star, in increasing order.
+ * left for the end, when its sum is redone over its whole star, in increasing order
+ * (over all its triangles when its star misses some: separate fans meeting at the
+ * vertex).
  *
- * Run c starts at triangle b_c with smallest vertex m_c. If every triangle of runs c >= 1
- * has its smallest vertex at least m_c and m_1 <= m_2 <= ... (true of delaunay2d()'s
+ * Run c starts at triangle b_c with smallest vertex m_c. If every triangle of runs c >=
+ * 1 has its smallest vertex at least m_c and m_1 <= m_2 <= ... (true of delaunay2d()'s
  * canonical order), run c adds directly to the vertices below m_(c+1), which no later
  * run reaches, and defers the others; a vertex at or above m_c that an earlier run
- * reaches is deferred by that run. False, with the outputs unspecified, if the triangles
- * break that condition or a large mesh comes without its adjacency (then the gather
- * does the work on all threads). */
+ * reaches is deferred by that run. False, with the outputs unspecified, if the
+ * triangles break that condition or a large mesh comes without its adjacency (then the
+ * gather does the work on all threads). */
 bool
 scatterVertexNormals(std::size_t num_vertices,
                      const std::vector<Triangle>& triangles,
@@ -350,6 +388,10 @@ scatterVertexNormals(std::size_t num_vertices,
   std::vector<Eigen::Vector3d> sums(num_vertices, Eigen::Vector3d::Zero());
   vertex_areas.assign(num_vertices, 0.0);
   std::vector<std::vector<std::pair<pcl::index_t, pcl::index_t>>> deferred(runs);
+  // With several runs, the corners each vertex gets directly; with its deferred corners
+  // they tell whether the walk around a deferred vertex finds all its triangles.
+  std::vector<pcl::index_t> corners(runs > 1 ? num_vertices : 0, 0);
+  pcl::index_t* const direct = runs > 1 ? corners.data() : nullptr;
   std::vector<char> out_of_order(runs, 0);
 #pragma omp parallel for num_threads(static_cast<int>(runs)) schedule(static, 1)
   for (std::ptrdiff_t c = 0; c < static_cast<std::ptrdiff_t>(runs); ++c) {
@@ -372,6 +414,8 @@ scatterVertexNormals(std::size_t num_vertices,
           vertex_areas[v] += areas[t];
         if (weight > 0.0)
           sums[v] += term;
+        if (direct)
+          ++direct[v];
       }
     }
   }
@@ -385,6 +429,8 @@ scatterVertexNormals(std::size_t num_vertices,
   std::vector<std::pair<pcl::index_t, pcl::index_t>> redo;
   for (const auto& run : deferred)
     redo.insert(redo.end(), run.begin(), run.end());
+  for (const auto& seed : redo)
+    ++corners[seed.first];
   if (!redo.empty())
     recomputeOverStars(redo,
                        triangles,
@@ -393,7 +439,8 @@ scatterVertexNormals(std::size_t num_vertices,
                        areas,
                        vertex_normals,
                        vertex_areas,
-                       static_cast<int>(runs));
+                       static_cast<int>(runs),
+                       &corners);
   return true;
 }
 
@@ -519,6 +566,8 @@ starOf(pcl::index_t v,
       break; // around an interior vertex: one way is enough
   }
   std::sort(star.begin(), star.end());
+  // Around a non-manifold edge the two walks can meet the same triangle.
+  star.erase(std::unique(star.begin(), star.end()), star.end());
 }
 
 } // namespace

@@ -58,7 +58,11 @@ PCL_EXPORTS void computeTriangleNormals(const Vector3fVector& positions,
  *            the threads when the adjacency is given and the triangles come in
  *            delaunay2d()'s canonical order (by smallest vertex); without them the
  *            sums of a large mesh are gathered through vertex -> triangle lists on all
- *            threads (the same bits again). On one thread or below
+ *            threads (the same bits again). A vertex shared by two threads' triangles
+ *            is summed over the triangles found by walking the adjacency around it, or,
+ *            when they are fewer than its corners (separate fans meeting at the vertex:
+ *            not in a Delaunay mesh), over those found by a pass over the mesh; the
+ *            same bits for any mesh. On one thread or below
  *            detail::kMinParallelItems triangles the pass is sequential, for any
  *            triangle order.
  */
@@ -158,7 +162,9 @@ PCL_EXPORTS void updateTriangleNormalsAndEdgeOn(const Vector3fVector& positions,
  * (eq. 2-3) of the changed triangles' vertices, from the triangle normals and areas of
  * the whole mesh; the other vertices' values are taken as valid. Gives the values
  * computeVertexNormals() computes on the whole mesh, bit for bit (each vertex's
- * triangles, found through the adjacency, are summed in increasing order).
+ * triangles, found through the adjacency, are summed in increasing order), where each
+ * vertex's triangles form one fan (every Delaunay mesh; at a vertex where separate fans
+ * meet only the fan of the changed triangle is summed).
  * \param[in] neighbours the triangle adjacency (computeTriangleNeighbours())
  * \param[in] changed_triangles triangles whose corners or corner positions changed
  * \param[in,out] vertex_normals, vertex_areas per vertex, sized for the mesh */
