@@ -1136,6 +1136,47 @@ TEST(Delaunay2DVtk, MatchesBoostAwayFromTheHull)
   EXPECT_LT(boost.size() - vtk.size(), boost.size() / 50);
 }
 
+TEST(Delaunay2DVtk, FailsInsteadOfCrashingOrReturningABrokenMesh)
+{
+  if (!isDelaunayBackendAvailable(DelaunayBackend::Vtk))
+    GTEST_SKIP() << "library built without VTK";
+  // Points 1 apart beside points 2^26 away: vtkDelaunay2D recursed until the stack
+  // overflowed on the first, and logged "Edge is non-manifold" and gave no triangle
+  // on the second, which was returned as a success.
+  const Points overflows{{-67108863, 0},
+                         {67108863, -1},
+                         {67108863, 1},
+                         {-1, -1},
+                         {-1, 0},
+                         {0, 0},
+                         {1, 1},
+                         {-67108863, -67108864},
+                         {1, 0}};
+  const Points non_manifold{{-67108864, -67108864},
+                            {-67108863, 0},
+                            {-67108864, -1},
+                            {-67108863, -67108864},
+                            {-67108864, 1},
+                            {0, -67108864},
+                            {-67108864, 67108864}};
+  for (const Points& points : {overflows, non_manifold}) {
+    Triangles triangles{{0, 1, 2}};
+    std::string error;
+    EXPECT_FALSE(delaunay2d(points, DelaunayBackend::Vtk, triangles, &error));
+    EXPECT_TRUE(triangles.empty());
+    EXPECT_NE(error.find("vtk"), std::string::npos) << error;
+    // The exact backends triangulate them.
+    EXPECT_TRUE(isCanonicalDelaunay(points, triangulate(points)));
+  }
+  // Well spread points over the whole range are triangulated.
+  std::mt19937 rng(5);
+  const Points spread = uniformPoints(300, kMaxDelaunayCoordinate, rng);
+  Triangles triangles;
+  std::string error;
+  EXPECT_TRUE(delaunay2d(spread, DelaunayBackend::Vtk, triangles, &error)) << error;
+  EXPECT_FALSE(triangles.empty());
+}
+
 int
 main(int argc, char** argv)
 {

@@ -6,10 +6,17 @@
 
 #include <vtkCellArray.h>
 #include <vtkCellArrayIterator.h>
+#include <vtkCommand.h>
 #include <vtkDelaunay2D.h>
+#include <vtkExecutive.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkSmartPointer.h>
+
+#include <cctype>
+#include <cmath>
+#include <limits>
+#include <set>
 
 #include "delaunay_2d_backends.h"
 
@@ -24,6 +31,113 @@ namespace {
  * and the diagonal is at most 2 * sqrt(2) * 2^26 < 1.9e8, so with 1e-9 the merge
  * distance stays below 0.19 and no distinct point is ever discarded. */
 constexpr double kVtkTolerance = 1e-9;
+
+/** vtkDelaunay2D's floating point fails on points much closer together than the extent
+ * of the cloud: with two points 1 apart and others 2.4e7 to 1.3e8 away it reported
+ * "Edge is non-manifold" and gave no triangles, or recursed until the stack overflowed.
+ * Its arithmetic does not depend on the scale, so centring or scaling does not help;
+ * inputs whose bounding box is wider or taller than this many times the distance of the
+ * closest two points are refused. */
+constexpr double kVtkMaxSpread = 1 << 22;
+
+/** Records the errors VTK reports instead of letting it print them. */
+class ErrorObserver : public vtkCommand {
+public:
+  static ErrorObserver* New() { return new ErrorObserver; }
+
+  void Execute(vtkObject*, unsigned long, void* call_data) override
+  {
+    if (!message.empty())
+      return;
+    // "ERROR: In <file>, line <n>\n<class> (<address>): ERROR: <text>\n\n": the text.
+    message = call_data ? static_cast<const char*>(call_data) : "unknown error";
+    const auto text = message.rfind("ERROR: ");
+    if (text != std::string::npos)
+      message.erase(0, text + 7);
+    while (!message.empty() && std::isspace(static_cast<unsigned char>(message.back())))
+      message.pop_back();
+  }
+
+  std::string message;
+};
+
+/** Squared distance of the closest two of the (distinct) points: a sweep in x order
+ * that keeps the points within the best distance so far, ordered by y. */
+std::int64_t
+closestPairSquared(std::vector<QuantizedPoint> points)
+{
+  std::sort(points.begin(), points.end());
+  std::int64_t best = std::numeric_limits<std::int64_t>::max();
+  std::set<std::pair<std::int32_t, std::int32_t>> near; // (y, x)
+  std::size_t left = 0;
+  for (const auto& p : points) {
+    const auto reach =
+        static_cast<std::int64_t>(std::sqrt(static_cast<double>(best))) + 1;
+    while (left < points.size() && p[0] - std::int64_t{points[left][0]} > reach) {
+      near.erase({points[left][1], points[left][0]});
+      ++left;
+    }
+    const auto low = static_cast<std::int32_t>(
+        std::max<std::int64_t>(p[1] - reach, std::numeric_limits<std::int32_t>::min()));
+    for (auto it = near.lower_bound({low, std::numeric_limits<std::int32_t>::min()});
+         it != near.end() && std::int64_t{it->first} - p[1] <= reach;
+         ++it) {
+      const std::int64_t dx = std::int64_t{p[0]} - it->second;
+      const std::int64_t dy = std::int64_t{p[1]} - it->first;
+      best = std::min(best, dx * dx + dy * dy);
+    }
+    near.insert({p[1], p[0]});
+  }
+  return best;
+}
+
+/** Whether vtkDelaunay2D can be trusted with the points (kVtkMaxSpread). */
+bool
+checkSpread(const std::vector<QuantizedPoint>& points, std::string* error)
+{
+  std::int64_t side = 0;
+  for (int k = 0; k < 2; ++k) {
+    const auto [lo, hi] =
+        std::minmax_element(points.begin(),
+                            points.end(),
+                            [k](const auto& a, const auto& b) { return a[k] < b[k]; });
+    side = std::max(side, std::int64_t{(*hi)[k]} - (*lo)[k]);
+  }
+  const double closest = std::sqrt(static_cast<double>(closestPairSquared(points)));
+  if (static_cast<double>(side) <= kVtkMaxSpread * closest)
+    return true;
+  setError(error,
+           "delaunay2d (vtk): the points span " + std::to_string(side) +
+               " but the closest two are " + std::to_string(std::lround(closest)) +
+               " apart; vtkDelaunay2D fails beyond a ratio of " +
+               std::to_string(static_cast<long>(kVtkMaxSpread)) +
+               " (use the sweep or boost backend, or a coarser quantization)");
+  return false;
+}
+
+/** Whether the triangles can be part of a planar triangulation of the points: each
+ * directed edge used at most once, and at most 2 n - 5 triangles. */
+bool
+checkResult(const std::vector<QuantizedPoint>& points,
+            const std::vector<Triangle>& triangles,
+            std::string* error)
+{
+  std::vector<std::pair<index_t, index_t>> edges;
+  edges.reserve(3 * triangles.size());
+  for (const auto& t : triangles)
+    for (int i = 0; i < 3; ++i)
+      edges.emplace_back(t[i], t[(i + 1) % 3]);
+  std::sort(edges.begin(), edges.end());
+  const bool overlap = std::adjacent_find(edges.begin(), edges.end()) != edges.end();
+  if (!overlap && triangles.size() + 5 <= 2 * points.size())
+    return true;
+  setError(error,
+           "delaunay2d (vtk): vtkDelaunay2D returned " +
+               std::to_string(triangles.size()) + " triangles for " +
+               std::to_string(points.size()) + " points" +
+               (overlap ? ", some overlapping (an edge used twice)" : ""));
+  return false;
+}
 
 vtkSmartPointer<vtkPolyData>
 toPolyData(const std::vector<QuantizedPoint>& points)
@@ -62,10 +176,21 @@ delaunayVtk(const std::vector<QuantizedPoint>& points,
             std::string* error)
 {
   triangles.clear();
+  if (!checkSpread(points, error))
+    return false;
   auto delaunay = vtkSmartPointer<vtkDelaunay2D>::New();
   delaunay->SetInputData(toPolyData(points));
   delaunay->SetTolerance(kVtkTolerance);
+  // An error of the filter (such as "Edge is non-manifold") or of its pipeline is a
+  // failure; observed, it is not printed by VTK.
+  auto errors = vtkSmartPointer<ErrorObserver>::New();
+  delaunay->AddObserver(vtkCommand::ErrorEvent, errors);
+  delaunay->GetExecutive()->AddObserver(vtkCommand::ErrorEvent, errors);
   delaunay->Update();
+  if (!errors->message.empty()) {
+    setError(error, "delaunay2d (vtk): vtkDelaunay2D failed: " + errors->message);
+    return false;
+  }
   vtkCellArray* polys = delaunay->GetOutput()->GetPolys();
   if (!polys) {
     if (error)
@@ -87,6 +212,10 @@ delaunayVtk(const std::vector<QuantizedPoint>& points,
                    static_cast<index_t>(ids[1]),
                    static_cast<index_t>(ids[2]),
                    triangles);
+  }
+  if (!checkResult(points, triangles, error)) {
+    triangles.clear();
+    return false;
   }
   return true;
 }

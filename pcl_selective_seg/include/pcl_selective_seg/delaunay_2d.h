@@ -52,7 +52,11 @@ enum class DelaunayBackend : std::uint8_t {
    * may drop thin triangles along the hull (any triangle whose circumcircle reaches its
    * initial bounding triangulation, which can include triangles one layer inside the
    * hull) and does not split co-circular points by the canonical rule, so its output
-   * can differ from the exact backends. */
+   * can differ from the exact backends. It fails (false, with a message) on points
+   * whose bounding box is wider or taller than 2^22 times the distance of the closest
+   * two (there vtkDelaunay2D gave no triangles or overflowed the stack), on any error
+   * vtkDelaunay2D reports, and on a result that is no triangulation (an edge used twice
+   * in one direction, or more than 2 n - 5 triangles). */
   Vtk = 1,
   /** Our own incremental triangulation: an advancing front sweeps the points in
    * lexicographic order (x, then y), exact integer predicates throughout. Always
@@ -80,9 +84,9 @@ PCL_EXPORTS bool isDelaunayBackendAvailable(DelaunayBackend backend);
  *             smallest vertex id comes first, the list sorted lexicographically. The
  *             result therefore depends only on the point coordinates and their ids.
  * \param[out] error reason for a failure (may be null).
- * \return false on a precondition violation or an unavailable backend (triangles
- *         empty). Fewer than three points, or all points collinear, is not a failure:
- *         the result is then empty.
+ * \return false on a precondition violation, an unavailable backend or a failure of
+ *         the Vtk backend (triangles empty). Fewer than three points, or all points
+ * collinear, is not a failure: the result is then empty.
  *
  * Groups of four or more co-circular points (every regular grid has them) have no
  * unique Delaunay triangulation. The exact backends split each such empty circle's
