@@ -15,8 +15,6 @@
 
 #include <cctype>
 #include <cmath>
-#include <limits>
-#include <set>
 
 #include "delaunay_2d_backends.h"
 
@@ -31,14 +29,6 @@ namespace {
  * and the diagonal is at most 2 * sqrt(2) * 2^26 < 1.9e8, so with 1e-9 the merge
  * distance stays below 0.19 and no distinct point is ever discarded. */
 constexpr double kVtkTolerance = 1e-9;
-
-/** vtkDelaunay2D's floating point fails on points much closer together than the extent
- * of the cloud: with two points 1 apart and others 2.4e7 to 1.3e8 away it reported
- * "Edge is non-manifold" and gave no triangles, or recursed until the stack overflowed.
- * Its arithmetic does not depend on the scale, so centring or scaling does not help;
- * inputs whose bounding box is wider or taller than this many times the distance of the
- * closest two points are refused. */
-constexpr double kVtkMaxSpread = 1 << 22;
 
 /** Records the errors VTK reports instead of letting it print them. */
 class ErrorObserver : public vtkCommand {
@@ -60,60 +50,6 @@ public:
 
   std::string message;
 };
-
-/** Squared distance of the closest two of the (distinct) points: a sweep in x order
- * that keeps the points within the best distance so far, ordered by y. */
-std::int64_t
-closestPairSquared(std::vector<QuantizedPoint> points)
-{
-  std::sort(points.begin(), points.end());
-  std::int64_t best = std::numeric_limits<std::int64_t>::max();
-  std::set<std::pair<std::int32_t, std::int32_t>> near; // (y, x)
-  std::size_t left = 0;
-  for (const auto& p : points) {
-    const auto reach =
-        static_cast<std::int64_t>(std::sqrt(static_cast<double>(best))) + 1;
-    while (left < points.size() && p[0] - std::int64_t{points[left][0]} > reach) {
-      near.erase({points[left][1], points[left][0]});
-      ++left;
-    }
-    const auto low = static_cast<std::int32_t>(
-        std::max<std::int64_t>(p[1] - reach, std::numeric_limits<std::int32_t>::min()));
-    for (auto it = near.lower_bound({low, std::numeric_limits<std::int32_t>::min()});
-         it != near.end() && std::int64_t{it->first} - p[1] <= reach;
-         ++it) {
-      const std::int64_t dx = std::int64_t{p[0]} - it->second;
-      const std::int64_t dy = std::int64_t{p[1]} - it->first;
-      best = std::min(best, dx * dx + dy * dy);
-    }
-    near.insert({p[1], p[0]});
-  }
-  return best;
-}
-
-/** Whether vtkDelaunay2D can be trusted with the points (kVtkMaxSpread). */
-bool
-checkSpread(const std::vector<QuantizedPoint>& points, std::string* error)
-{
-  std::int64_t side = 0;
-  for (int k = 0; k < 2; ++k) {
-    const auto [lo, hi] =
-        std::minmax_element(points.begin(),
-                            points.end(),
-                            [k](const auto& a, const auto& b) { return a[k] < b[k]; });
-    side = std::max(side, std::int64_t{(*hi)[k]} - (*lo)[k]);
-  }
-  const double closest = std::sqrt(static_cast<double>(closestPairSquared(points)));
-  if (static_cast<double>(side) <= kVtkMaxSpread * closest)
-    return true;
-  setError(error,
-           "delaunay2d (vtk): the points span " + std::to_string(side) +
-               " but the closest two are " + std::to_string(std::lround(closest)) +
-               " apart; vtkDelaunay2D fails beyond a ratio of " +
-               std::to_string(static_cast<long>(kVtkMaxSpread)) +
-               " (use the sweep or boost backend, or a coarser quantization)");
-  return false;
-}
 
 /** Whether the triangles can be part of a planar triangulation of the points: each
  * directed edge used at most once, and at most 2 n - 5 triangles. */
@@ -176,8 +112,6 @@ delaunayVtk(const std::vector<QuantizedPoint>& points,
             std::string* error)
 {
   triangles.clear();
-  if (!checkSpread(points, error))
-    return false;
   auto delaunay = vtkSmartPointer<vtkDelaunay2D>::New();
   delaunay->SetInputData(toPolyData(points));
   delaunay->SetTolerance(kVtkTolerance);
