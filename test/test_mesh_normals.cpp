@@ -144,6 +144,59 @@ TEST(MeshNormals, DegenerateTriangles)
   expectVectorNear(normals[2], Eigen::Vector3f(0.f, 0.f, -1.f));
 }
 
+TEST(MeshNormals, TrianglesFlatAtFloatPrecisionAreDegenerate)
+{
+  // Three points of a line in 3-D, rounded to float: a triangle of non-zero area whose
+  // height (about 1.2e-7 m, under FLT_EPSILON * |p| = 2.4e-7 m) is rounding alone, so
+  // its normal is noise. It gets no normal, is edge-on, and leaves eq. 2 to the
+  // triangle that has one; its area is kept. Lifting the middle point by 8 ulps (h
+  // about 8 FLT_EPSILON * |p|) gives a triangle whose normal is determined.
+  const Eigen::Vector3d start(0.3, 0.2, 2.0), step(0.01, 0.003, 0.002);
+  Vector3fVector positions;
+  for (int i = 0; i < 3; ++i)
+    positions.push_back((start + i * step).cast<float>());
+  positions.push_back(Eigen::Vector3f(0.31f, 0.25f, 2.0f));
+  Eigen::Vector3f lifted = positions[1];
+  for (int i = 0; i < 8; ++i)
+    lifted.z() = std::nextafter(lifted.z(), 3.f);
+  positions.push_back(lifted);
+  const std::vector<Triangle> triangles{{0, 1, 2}, {0, 1, 3}, {0, 4, 2}};
+  Vector3fVector normals;
+  std::vector<double> areas;
+  std::vector<std::uint8_t> edge_on;
+  pcl::selective_seg::computeTriangleNormalsAndEdgeOn(positions,
+                                                      triangles,
+                                                      Eigen::Vector3f::Zero(),
+                                                      85.0 * kDeg,
+                                                      normals,
+                                                      areas,
+                                                      edge_on);
+  ASSERT_GT(areas[0], 0.0); // not collinear in float
+  const double longest = (positions[2] - positions[0]).cast<double>().norm();
+  EXPECT_LT(2.0 * areas[0] / longest,
+            std::numeric_limits<float>::epsilon() * positions[2].norm());
+  EXPECT_FALSE(normals[0].allFinite());
+  EXPECT_EQ(edge_on[0], 1);
+  ASSERT_TRUE(normals[1].allFinite());
+  EXPECT_TRUE(normals[2].allFinite());
+  Vector3fVector vertex_normals;
+  std::vector<double> vertex_areas;
+  const std::vector<Triangle> star{triangles[0], triangles[1]};
+  const Vector3fVector star_normals{normals[0], normals[1]};
+  const std::vector<double> star_areas{areas[0], areas[1]};
+  computeVertexNormals(5, star, star_normals, star_areas, vertex_normals, vertex_areas);
+  expectVectorNear(vertex_normals[0], normals[1]);
+  EXPECT_EQ(vertex_areas[0], areas[0] + areas[1]);
+  EXPECT_FALSE(vertex_normals[2].allFinite()); // only on the flat triangle
+  // computeTriangleNormals() agrees.
+  Vector3fVector normals_alone;
+  std::vector<double> areas_alone;
+  computeTriangleNormals(
+      positions, triangles, Eigen::Vector3f::Zero(), normals_alone, areas_alone);
+  EXPECT_FALSE(normals_alone[0].allFinite());
+  EXPECT_EQ(areas_alone[0], areas[0]);
+}
+
 TEST(MeshNormals, HugeCoordinatesGiveFiniteArea)
 {
   // Legs of 1e30: the area 5e59 overflows a float (max 3.4e38) but not a double.

@@ -339,6 +339,40 @@ TEST(SelectiveSegmentation, WallFacingTheSensorIsOneSegment)
   EXPECT_EQ(labeled->height, 40u);
 }
 
+TEST(SelectiveSegmentation, TiltedPlaneSeenByAPixelGridIsOneSegment)
+{
+  // A noise-free plane seen by a 160 x 120 pinhole grid. Float rounding of the points
+  // makes each image row and column a zig-zag of one quantization step in (theta,
+  // phi); along the border the triangulation then joins three points of one row or
+  // column, collinear in 3-D up to float rounding: triangles of area ~1e-9 m^2 against
+  // ~1e-4 m^2, whose normals are noise and would dominate eq. 2's 1 / A weights (98
+  // segments). They are degenerate: one segment, every normal the plane's.
+  const Eigen::Vector3f n = Eigen::Vector3f(0.3f, 0.2f, -1.f).normalized();
+  auto cloud = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  const int width = 160, height = 120;
+  const double focal = 200.0, distance = 2.0;
+  for (int j = 0; j < height; ++j)
+    for (int i = 0; i < width; ++i) {
+      const Eigen::Vector3d ray(
+          (i - width / 2 + 0.5) / focal, (j - height / 2 + 0.5) / focal, 1.0);
+      const Eigen::Vector3f p =
+          (ray * (-distance / n.cast<double>().dot(ray))).cast<float>();
+      cloud->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
+    }
+  SelectiveSegmentation<pcl::PointXYZ> seg;
+  std::vector<pcl::PointIndices> clusters;
+  ASSERT_TRUE(segment<pcl::PointXYZ>(cloud, seg, clusters));
+  ASSERT_EQ(clusters.size(), 1u);
+  EXPECT_EQ(clusters[0].indices.size(), cloud->size());
+  const auto normals = seg.getPointNormals();
+  ASSERT_EQ(normals->size(), cloud->size());
+  for (const auto& point : *normals) {
+    const Eigen::Vector3f m(point.normal_x, point.normal_y, point.normal_z);
+    ASSERT_TRUE(m.allFinite());
+    EXPECT_GT(std::abs(m.dot(n)), std::cos(0.1 * M_PI / 180.0));
+  }
+}
+
 TEST(SelectiveSegmentation, FloorSeenByALevelCameraInTheVoxelFrame)
 {
   // A floor 1 m below a level camera (y down), x in [-1, 1], z in [1, 4], jittered

@@ -45,8 +45,21 @@ normalizedOrNaN(const Eigen::Vector3d& sum)
   return Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN());
 }
 
+/** A triangle's smallest height h = 2 A / L_max, in units of FLT_EPSILON * M (M the
+ * largest |corner|), at or below which its normal is not determined by its float
+ * corners. Rounding a coordinate to float moves it by at most FLT_EPSILON / 2 of its
+ * magnitude, so a corner by at most FLT_EPSILON / 2 * M; three collinear points so
+ * rounded form a triangle of height at most FLT_EPSILON * M (the apex and the foot of
+ * its height on the longest edge each move by at most half of that). A posed cloud's
+ * sensor-frame positions are rounded twice (the input, then the transform): twice
+ * that. A triangle this flat is consistent with three collinear points, so any normal
+ * about its longest edge fits its corners: it is degenerate. Above it, the normal's
+ * error from rounding is at most atan(kFlatHeight * FLT_EPSILON * M / h). */
+constexpr double kFlatHeight = 2.0;
+
 /** Normal (oriented toward the eye) and area of one triangle; the normal stays NaN
- * when the triangle is degenerate (then false; otherwise \a centroid is set). */
+ * when the triangle is degenerate: zero or non-finite area, or flat at float precision
+ * (kFlatHeight; its area is still given). Then false; otherwise \a centroid is set. */
 inline bool
 triangleNormal(const Vector3fVector& positions,
                const Triangle& triangle,
@@ -58,11 +71,29 @@ triangleNormal(const Vector3fVector& positions,
   const Eigen::Vector3d a = positions[triangle[0]].cast<double>();
   const Eigen::Vector3d b = positions[triangle[1]].cast<double>();
   const Eigen::Vector3d c = positions[triangle[2]].cast<double>();
-  Eigen::Vector3d n = (b - a).cross(c - a);
-  const double twice_area = n.norm();
+  const Eigen::Vector3d ab = b - a, ac = c - a; // exact: differences of floats
+  Eigen::Vector3d n = ab.cross(ac);
+  const double twice_area_squared = n.squaredNorm();
+  const double twice_area = std::sqrt(twice_area_squared); // as n.norm()
   area = 0.5 * twice_area;
   if (!(twice_area > 0.0) || !std::isfinite(twice_area))
     return false;
+  // h <= k eps M, squared and times L_max^2: (2 A)^2 <= (k eps)^2 M^2 L_max^2. First
+  // against a bound of M^2 L_max^2 from two edges and one corner (with s = |ab|^2 +
+  // |ac|^2, L_max^2 <= 2 s and M^2 <= 2 |a|^2 + 2 s): most triangles pass it.
+  constexpr double k_eps =
+      kFlatHeight * static_cast<double>(std::numeric_limits<float>::epsilon());
+  constexpr double k_eps_squared = k_eps * k_eps;
+  const double ab_squared = ab.squaredNorm(), ac_squared = ac.squaredNorm();
+  const double s = ab_squared + ac_squared;
+  if (!(twice_area_squared > k_eps_squared * 4.0 * s * (a.squaredNorm() + s))) {
+    const double longest_squared =
+        std::max(std::max(ab_squared, ac_squared), (c - b).squaredNorm());
+    const double farthest_squared =
+        std::max(std::max(a.squaredNorm(), b.squaredNorm()), c.squaredNorm());
+    if (twice_area_squared <= k_eps_squared * farthest_squared * longest_squared)
+      return false;
+  }
   n /= twice_area;
   centroid = (a + b + c) / 3.0;
   if (n.dot(centroid - eye) > 0.0)

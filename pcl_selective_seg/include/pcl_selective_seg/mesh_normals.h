@@ -26,9 +26,13 @@ using Vector3fVector = std::vector<Eigen::Vector3f>;
  * \param[in] triangles \#T triangles over vertex ids
  * \param[in] viewpoint sensor origin in the frame of \a positions [m]; each normal is
  *            oriented toward it (n . (centroid - viewpoint) <= 0)
- * \param[out] normals \#T unit normals; NaN for a degenerate (zero-area) triangle
+ * \param[out] normals \#T unit normals; NaN for a degenerate triangle: zero or
+ *             non-finite area, or flat at float precision (smallest height 2 A_t /
+ *             L_max at most 2 FLT_EPSILON max |corner|: within the rounding of its
+ *             float corners it may be collinear, so its normal is not determined;
+ *             such slivers appear where rows of a pixel grid are straight lines)
  * \param[out] areas \#T areas A_t [m^2], computed in double precision (finite for any
- *             finite float input)
+ *             finite float input; a flat triangle keeps its area)
  */
 PCL_EXPORTS void computeTriangleNormals(const Vector3fVector& positions,
                                         const std::vector<Triangle>& triangles,
