@@ -179,11 +179,11 @@ TEST(SelectiveLoop, WindowsStayInTheViewAndTheBudgetIsUsed)
   params.iterations = 30;
   params.point_budget = 4000;
   std::vector<sim::ScanScore> rounds;
-  const pcl::PointCloud<pcl::PointXYZL>* last = nullptr;
+  pcl::PointCloud<pcl::PointXYZL> last; // a copy: the loop's clouds end with it
   std::size_t windows = 0;
   ASSERT_TRUE(sim::runSelectiveLoop(
       setup, params, reference, rounds, [&](const sim::LoopRound& r) {
-        last = r.cloud;
+        last = *r.cloud;
         for (const auto& w : *r.regions) {
           ++windows;
           EXPECT_GE(w.theta_min, setup.sensor.theta_min);
@@ -192,11 +192,11 @@ TEST(SelectiveLoop, WindowsStayInTheViewAndTheBudgetIsUsed)
           EXPECT_LE(w.phi_max, setup.sensor.phi_max);
         }
       }));
-  ASSERT_NE(last, nullptr);
+  ASSERT_EQ(last.size(), rounds.back().points);
   EXPECT_GT(windows, 0u);
   // Every point acquired lies in the view (up to the float rounding of its angles).
   std::size_t outside = 0;
-  for (const auto& p : *last) {
+  for (const auto& p : last) {
     const double theta = std::atan2(p.x, p.z);
     const double phi = std::atan2(p.y, p.z);
     if (theta < setup.sensor.theta_min - 1e-6 ||
