@@ -195,12 +195,11 @@ twoFaces(double a, double b, double jump_scale = 0.0)
   return g;
 }
 
+/** describeBoundaryPoints() of the listed points of \a g (sensor at the origin, every
+ * edge, 85 deg incidence). */
 std::vector<metrics::BoundaryEdgeKind>
-describe(const Grid& g, pcl::Indices* boundary_out = nullptr)
+describeListed(const Grid& g, const pcl::Indices& boundary)
 {
-  pcl::Indices boundary;
-  EXPECT_TRUE(metrics::labelBoundaryPoints(
-      g.cloud, g.triangles, g.labels, Eigen::Vector3f::Zero(), M_PI, boundary));
   std::vector<metrics::BoundaryEdgeKind> kinds;
   EXPECT_TRUE(metrics::describeBoundaryPoints(g.cloud,
                                               g.triangles,
@@ -211,9 +210,19 @@ describe(const Grid& g, pcl::Indices* boundary_out = nullptr)
                                               boundary,
                                               kinds));
   EXPECT_EQ(kinds.size(), boundary.size());
+  return kinds;
+}
+
+/** describeListed() of the boundary points labelBoundaryPoints() finds. */
+std::vector<metrics::BoundaryEdgeKind>
+describe(const Grid& g, pcl::Indices* boundary_out = nullptr)
+{
+  pcl::Indices boundary;
+  EXPECT_TRUE(metrics::labelBoundaryPoints(
+      g.cloud, g.triangles, g.labels, Eigen::Vector3f::Zero(), M_PI, boundary));
   if (boundary_out)
     *boundary_out = boundary;
-  return kinds;
+  return describeListed(g, boundary);
 }
 
 } // namespace
@@ -322,15 +331,7 @@ TEST(DescribeBoundaryPoints, PointListedTwiceIsDescribedTwice)
   ASSERT_FALSE(boundary.empty());
   pcl::Indices twice = boundary;
   twice.push_back(boundary.front());
-  std::vector<metrics::BoundaryEdgeKind> again;
-  ASSERT_TRUE(metrics::describeBoundaryPoints(g.cloud,
-                                              g.triangles,
-                                              g.labels,
-                                              Eigen::Vector3f::Zero(),
-                                              M_PI,
-                                              85.0 * M_PI / 180.0,
-                                              twice,
-                                              again));
+  const auto again = describeListed(g, twice);
   ASSERT_EQ(again.size(), twice.size());
   for (std::size_t k = 0; k < twice.size(); ++k) {
     const auto& expected = kinds[k < boundary.size() ? k : 0];

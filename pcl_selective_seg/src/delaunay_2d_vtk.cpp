@@ -13,8 +13,9 @@
 #include <vtkPolyData.h>
 #include <vtkSmartPointer.h>
 
+#include <algorithm>
 #include <cctype>
-#include <cmath>
+#include <string>
 
 #include "delaunay_2d_backends.h"
 
@@ -127,8 +128,7 @@ delaunayVtk(const std::vector<QuantizedPoint>& points,
   }
   vtkCellArray* polys = delaunay->GetOutput()->GetPolys();
   if (!polys) {
-    if (error)
-      *error = "delaunay2d (vtk): vtkDelaunay2D produced no polygons";
+    setError(error, "delaunay2d (vtk): vtkDelaunay2D produced no polygons");
     return false;
   }
   // vtkDelaunay2D keeps the input points, so its point ids are the input ids.
