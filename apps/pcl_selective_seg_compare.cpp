@@ -221,6 +221,9 @@ methods()
   mean_frame.normal_spread_frame = pcl::selective_seg::NormalSpreadFrame::MeanNormal;
   SelectiveSegmentationParameters area_weight = defaults;
   area_weight.segment_normal_weight = pcl::selective_seg::SegmentNormalWeight::Area;
+  SelectiveSegmentationParameters not_edge_on = defaults;
+  not_edge_on.point_normal_triangles =
+      pcl::selective_seg::PointNormalTriangles::NotEdgeOn;
   const auto selective = [](const SelectiveSegmentationParameters& p) {
     return [p](const Cloud::ConstPtr& c) { return runSelective(c, p); };
   };
@@ -228,6 +231,7 @@ methods()
           {"selective (default)", selective(defaults)},
           {"selective (eq. 5 in the voxel's frame)", selective(mean_frame)},
           {"selective (eq. 7 weighted by area)", selective(area_weight)},
+          {"selective (eq. 2 without edge-on triangles)", selective(not_edge_on)},
           {"selective (rings 3)", selective(rings3)},
           {"selective (rings 2, vertex-mean eq. 8)", selective(robust2)},
           {"selective (rings 3, vertex-mean eq. 8)", selective(robust3)},

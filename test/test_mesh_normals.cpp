@@ -484,6 +484,116 @@ TEST(MeshNormals, RingNeighbourhoodsWidenEqTwo)
   EXPECT_TRUE(rings2[2].isApprox(Eigen::Vector3f(1, 0.25f, -2).normalized(), 1e-6f));
 }
 
+TEST(MeshNormals, EdgeOnTrianglesLeftOutOfEqTwoWhereOthersRemain)
+{
+  // PointNormalTriangles::NotEdgeOn. Vertex 0 is shared by t0 (normal -z, area 1) and
+  // the edge-on t1 (normal +x, area 0.25, which eq. 2's 1 / A weights four times
+  // more); vertices 3 and 4 have t1 only.
+  using namespace pcl::selective_seg;
+  const std::vector<Triangle> triangles{{0, 1, 2}, {0, 3, 4}};
+  const Vector3fVector normals{{0.f, 0.f, -1.f}, {1.f, 0.f, 0.f}};
+  const std::vector<double> areas{1.0, 0.25};
+  const std::vector<std::uint8_t> edge_on{0, 1};
+  Vector3fVector masked, paper, vertex_normals;
+  std::vector<double> paper_areas, vertex_areas;
+  maskEdgeOnNormals(normals, edge_on, masked);
+  ASSERT_EQ(masked.size(), 2u);
+  EXPECT_EQ(masked[0], normals[0]);
+  EXPECT_FALSE(masked[1].allFinite());
+  computeVertexNormals(5, triangles, normals, areas, paper, paper_areas);
+  computeVertexNormals(5, triangles, masked, areas, vertex_normals, vertex_areas);
+  // The paper: (0, 0, -1) + 4 (1, 0, 0), 76 degrees from the facing triangle's.
+  expectVectorNear(paper[0], Eigen::Vector3f(4.f, 0.f, -1.f).normalized());
+  // Without t1: t0's normal alone. A_p (eq. 3) still counts t1.
+  expectVectorNear(vertex_normals[0], Eigen::Vector3f(0.f, 0.f, -1.f));
+  EXPECT_EQ(vertex_areas, paper_areas);
+  EXPECT_NEAR(vertex_areas[0], 1.25, 1e-12);
+  EXPECT_FALSE(vertex_normals[3].allFinite());
+  // Vertices 3 and 4, all of whose triangles are edge-on, get the paper's normal.
+  EXPECT_EQ(fillMissingVertexNormals(triangles, normals, areas, 1, vertex_normals), 2u);
+  for (const int v : {3, 4})
+    EXPECT_EQ(vertex_normals[v], paper[v]) << v;
+  for (const int v : {0, 1, 2})
+    expectVectorNear(vertex_normals[v], Eigen::Vector3f(0.f, 0.f, -1.f));
+  // Nothing left to fill: nothing changes.
+  const Vector3fVector filled = vertex_normals;
+  EXPECT_EQ(fillMissingVertexNormals(triangles, normals, areas, 1, vertex_normals), 0u);
+  EXPECT_EQ(vertex_normals, filled);
+}
+
+TEST(MeshNormals, FilledNormalsAreThePapersToTheBit)
+{
+  // On a random mesh with a third of its triangles flagged, every vertex the masked
+  // sums leave without a normal gets exactly the paper's one- or k-ring normal, for any
+  // thread count; a vertex with no valid triangle at all stays NaN.
+  using namespace pcl::selective_seg;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(-1.f, 1.f);
+  std::uniform_int_distribution<int> pick(0, 199);
+  std::vector<Triangle> triangles;
+  Vector3fVector normals;
+  std::vector<double> areas;
+  std::vector<std::uint8_t> edge_on;
+  for (int t = 0; t < 300; ++t) {
+    triangles.push_back({pick(rng), pick(rng), pick(rng)});
+    normals.push_back(Eigen::Vector3f(u(rng), u(rng), u(rng)).normalized());
+    areas.push_back(0.1 + 0.5 * (1.0 + u(rng)));
+    edge_on.push_back(rng() % 3 == 0);
+  }
+  const std::size_t num_vertices = 210; // the last ten in no triangle
+  Vector3fVector masked;
+  maskEdgeOnNormals(normals, edge_on, masked);
+  for (const int rings : {1, 3}) {
+    SCOPED_TRACE(rings);
+    Vector3fVector paper, reference;
+    std::vector<double> paper_areas;
+    computeVertexNormals(num_vertices, triangles, normals, areas, paper, paper_areas);
+    if (rings > 1)
+      computeVertexNormalsOverRings(
+          num_vertices, triangles, normals, areas, rings, paper);
+    std::size_t missing = 0;
+    for (const int threads : {1, 2, 3}) {
+      Vector3fVector vertex_normals;
+      std::vector<double> vertex_areas;
+      computeVertexNormals(num_vertices,
+                           triangles,
+                           masked,
+                           areas,
+                           vertex_normals,
+                           vertex_areas,
+                           threads);
+      if (rings > 1)
+        computeVertexNormalsOverRings(
+            num_vertices, triangles, masked, areas, rings, vertex_normals);
+      const Vector3fVector before = vertex_normals;
+      const std::size_t filled = fillMissingVertexNormals(
+          triangles, normals, areas, rings, vertex_normals, threads);
+      missing = 0;
+      for (std::size_t v = 0; v < num_vertices; ++v) {
+        if (before[v].allFinite()) {
+          ASSERT_EQ(std::memcmp(&vertex_normals[v], &before[v], sizeof before[v]), 0);
+          continue;
+        }
+        ++missing;
+        ASSERT_EQ(paper[v].allFinite(), vertex_normals[v].allFinite()) << v;
+        if (paper[v].allFinite())
+          ASSERT_EQ(std::memcmp(&vertex_normals[v], &paper[v], sizeof paper[v]), 0)
+              << v;
+      }
+      EXPECT_EQ(filled, missing - 10); // the unused vertices stay NaN
+      if (threads == 1)
+        reference = vertex_normals;
+      else
+        EXPECT_EQ(std::memcmp(reference.data(),
+                              vertex_normals.data(),
+                              sizeof(Eigen::Vector3f) * num_vertices),
+                  0);
+    }
+    if (rings == 1)
+      EXPECT_GT(missing, 20u); // not only the unused vertices
+  }
+}
+
 TEST(MeshNormals, TriangleNormalsFromVertexNormals)
 {
   using namespace pcl::selective_seg;

@@ -553,6 +553,41 @@ TEST(SelectiveSegmentationUpdate, RingNormalsAndVertexMeanEdgeTestAreUpdatedInPl
   }
 }
 
+TEST(SelectiveSegmentationUpdate, NormalsWithoutEdgeOnTrianglesAreUpdatedInPlace)
+{
+  // PointNormalTriangles::NotEdgeOn: a point normal still depends on its own
+  // triangles only (its k-ring's), with the fallback to all of them where every one is
+  // edge-on, so an update recomputes it where triangles changed and keeps the leaves
+  // elsewhere (one ring).
+  for (const int rings : {1, 2}) {
+    SCOPED_TRACE(rings);
+    Seg seg;
+    auto params = seg.getParameters();
+    params.point_normal_triangles = pcl::selective_seg::PointNormalTriangles::NotEdgeOn;
+    params.normal_rings = rings;
+    const auto coarse = toXYZ(*selseg_test::cubeScan(5000, 11));
+    ASSERT_NO_FATAL_FAILURE(updateWithInteriorWindow(coarse, params, params, seg));
+    if (rings == 1)
+      EXPECT_GT(seg.getUpdateStatistics().kept_leaves,
+                seg.getResult().leaves.size() / 2);
+    // The option is not a no-op on this scan: some point normals differ from the
+    // paper's eq. 2 over the same union.
+    Seg paper;
+    auto paper_params = params;
+    paper_params.point_normal_triangles = pcl::selective_seg::PointNormalTriangles::All;
+    paper.setParameters(paper_params);
+    reference(concat(*coarse, interiorWindow(*coarse)),
+              seg.getResult().min_voxel_size,
+              paper);
+    const auto a = seg.getPointNormals(), b = paper.getPointNormals();
+    ASSERT_EQ(a->size(), b->size());
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < a->size(); ++i)
+      differ += (*a)[i].getNormalVector3fMap() != (*b)[i].getNormalVector3fMap();
+    EXPECT_GT(differ, 0u);
+  }
+}
+
 TEST(SelectiveSegmentationUpdate, RotatedAndMovedSensorGivesTheSameResultAsExtract)
 {
   // The same scan with the sensor posed in the world: normals and leaves are reported

@@ -17,6 +17,7 @@ using pcl::console::print_info;
 using pcl::selective_seg::DelaunayBackend;
 using pcl::selective_seg::EdgeTriangleNormal;
 using pcl::selective_seg::NormalSpreadFrame;
+using pcl::selective_seg::PointNormalTriangles;
 using pcl::selective_seg::SegmentNormalWeight;
 using pcl::selective_seg::SelectiveSegmentationParameters;
 
@@ -87,6 +88,7 @@ segmentationFlags()
                                                  "-edge_deg",
                                                  "-incidence_deg",
                                                  "-normal_rings",
+                                                 "-normal_triangles",
                                                  "-edge_normal",
                                                  "-min_voxel_m",
                                                  "-voxel_factor",
@@ -123,6 +125,9 @@ printSegmentationHelp()
   print_info("  -normal_rings N        point normals over the N-ring of triangles; 1 = "
              "paper's eq. 2 (default %d)\n",
              d.normal_rings);
+  print_info("  -normal_triangles NAME triangles summed into a point normal (eq. 2): "
+             "all (paper) or not_edge_on (those within -incidence_deg of the line of "
+             "sight, all where none is) (default all)\n");
   print_info("  -edge_normal NAME      normal tested by eq. 8: facet (paper) or "
              "vertex_mean (noise-robust) (default facet)\n");
   print_info("  -min_voxel_m X         smallest octree voxel [m]; 0 = automatic "
@@ -172,6 +177,12 @@ parseSegmentationOptions(int argc, char** argv, SelectiveSegmentationParameters&
                    {{"sensor", NormalSpreadFrame::Sensor},
                     {"mean_normal", NormalSpreadFrame::MeanNormal}},
                    p.normal_spread_frame) ||
+      !parseChoice(argc,
+                   argv,
+                   "-normal_triangles",
+                   {{"all", PointNormalTriangles::All},
+                    {"not_edge_on", PointNormalTriangles::NotEdgeOn}},
+                   p.point_normal_triangles) ||
       !parseChoice(argc,
                    argv,
                    "-edge_normal",

@@ -673,6 +673,82 @@ updateVertexNormalsOverRings(const std::vector<Triangle>& triangles,
 }
 
 void
+maskEdgeOnNormals(const Vector3fVector& normals,
+                  const std::vector<std::uint8_t>& edge_on,
+                  Vector3fVector& masked,
+                  int num_threads)
+{
+  const Eigen::Vector3f nan =
+      Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN());
+  masked.resize(normals.size());
+  const auto n_tri = static_cast<std::ptrdiff_t>(normals.size());
+#pragma omp parallel for num_threads(threadCount(num_threads))                         \
+    schedule(static) if (normals.size() >= detail::kMinParallelItems)
+  for (std::ptrdiff_t t = 0; t < n_tri; ++t)
+    masked[t] = edge_on[t] ? nan : normals[t];
+}
+
+std::size_t
+fillMissingVertexNormals(const std::vector<Triangle>& triangles,
+                         const Vector3fVector& normals,
+                         const std::vector<double>& areas,
+                         int rings,
+                         Vector3fVector& vertex_normals,
+                         int num_threads)
+{
+  const std::size_t num_vertices = vertex_normals.size();
+  std::vector<pcl::index_t> missing;
+  for (std::size_t v = 0; v < num_vertices; ++v)
+    if (!vertex_normals[v].allFinite())
+      missing.push_back(static_cast<pcl::index_t>(v));
+  if (missing.empty())
+    return 0;
+  std::size_t filled = 0;
+  const auto give = [&](pcl::index_t v, const Eigen::Vector3f& normal) {
+    if (normal.allFinite()) {
+      vertex_normals[v] = normal;
+      ++filled;
+    }
+  };
+  if (rings > 1) {
+    // The k-ring sums walk beyond the missing vertices: the whole incidence.
+    const Incidence incident =
+        vertexTriangles(triangles, num_vertices, threadCount(num_threads));
+    const auto list = [&](pcl::index_t v, std::vector<pcl::index_t>& out) {
+      out.assign(incident.items.begin() + incident.offsets[v],
+                 incident.items.begin() + incident.offsets[v + 1]);
+    };
+    RingNormals ring_normals(triangles, normals, areas, num_vertices, rings);
+    for (const auto v : missing)
+      give(v, ring_normals.at(v, list));
+    return filled;
+  }
+  // One ring: the missing vertices' triangles, each listed once per corner at the
+  // vertex, in increasing order (as the gather of computeVertexNormals() sums them),
+  // from one pass over the mesh.
+  std::vector<pcl::index_t> slot(num_vertices, -1);
+  for (std::size_t k = 0; k < missing.size(); ++k)
+    slot[missing[k]] = static_cast<pcl::index_t>(k);
+  std::vector<std::vector<pcl::index_t>> lists(missing.size());
+  for (std::size_t t = 0; t < triangles.size(); ++t)
+    for (const auto v : triangles[t])
+      if (slot[v] >= 0)
+        lists[slot[v]].push_back(static_cast<pcl::index_t>(t));
+  for (std::size_t k = 0; k < missing.size(); ++k) {
+    Eigen::Vector3f normal;
+    double area;
+    vertexNormal(lists[k].data(),
+                 lists[k].data() + lists[k].size(),
+                 normals,
+                 areas,
+                 normal,
+                 area);
+    give(missing[k], normal);
+  }
+  return filled;
+}
+
+void
 computeTriangleNormalsFromVertices(const std::vector<Triangle>& triangles,
                                    const Vector3fVector& vertex_normals,
                                    Vector3fVector& normals)

@@ -89,6 +89,12 @@ SelectiveSegmentationParameters::validate(std::string* why) const
                   "segment_normal_weight",
                   static_cast<int>(segment_normal_weight),
                   "inverse_area or area (SegmentNormalWeight 0 or 1)");
+  if (point_normal_triangles != PointNormalTriangles::All &&
+      point_normal_triangles != PointNormalTriangles::NotEdgeOn)
+    return reject(why,
+                  "point_normal_triangles",
+                  static_cast<int>(point_normal_triangles),
+                  "all or not_edge_on (PointNormalTriangles 0 or 1)");
   if (normal_spread_frame != NormalSpreadFrame::Sensor &&
       normal_spread_frame != NormalSpreadFrame::MeanNormal)
     return reject(why,

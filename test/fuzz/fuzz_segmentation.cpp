@@ -209,6 +209,8 @@ LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size)
         static_cast<pcl::selective_seg::NormalSpreadFrame>((slot[11] >> 8) & 0xff);
     p.segment_normal_weight =
         static_cast<pcl::selective_seg::SegmentNormalWeight>((slot[11] >> 16) & 0xff);
+    p.point_normal_triangles =
+        static_cast<pcl::selective_seg::PointNormalTriangles>((slot[11] >> 24) & 0xff);
     p.delaunay_backend =
         static_cast<pcl::selective_seg::DelaunayBackend>(slot[12] & 0xff);
   } else {
@@ -218,6 +220,8 @@ LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size)
         static_cast<pcl::selective_seg::NormalSpreadFrame>((slot[11] >> 1) & 1);
     p.segment_normal_weight =
         static_cast<pcl::selective_seg::SegmentNormalWeight>((slot[11] >> 2) & 1);
+    p.point_normal_triangles =
+        static_cast<pcl::selective_seg::PointNormalTriangles>((slot[11] >> 3) & 1);
     if (slot[12] & 1)
       p.delaunay_backend = pcl::selective_seg::DelaunayBackend::BoostVoronoi;
   }

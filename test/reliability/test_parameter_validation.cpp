@@ -20,6 +20,7 @@
 using pcl::selective_seg::DelaunayBackend;
 using pcl::selective_seg::EdgeTriangleNormal;
 using pcl::selective_seg::NormalSpreadFrame;
+using pcl::selective_seg::PointNormalTriangles;
 using pcl::selective_seg::SegmentNormalWeight;
 using pcl::selective_seg::SelectiveSegmentationParameters;
 using Params = SelectiveSegmentationParameters;
@@ -108,6 +109,14 @@ fields()
        [](Params& p, double v) {
          p.segment_normal_weight =
              static_cast<SegmentNormalWeight>(static_cast<int>(v));
+       },
+       {2, 7, 255},
+       {0, 1}},
+      {"point_normal_triangles",
+       "all or not_edge_on",
+       [](Params& p, double v) {
+         p.point_normal_triangles =
+             static_cast<PointNormalTriangles>(static_cast<int>(v));
        },
        {2, 7, 255},
        {0, 1}},

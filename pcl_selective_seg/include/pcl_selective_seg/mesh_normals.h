@@ -100,6 +100,41 @@ PCL_EXPORTS void computeVertexNormalsOverRings(std::size_t num_vertices,
                                                int rings,
                                                Vector3fVector& vertex_normals);
 
+/** \brief The triangle normals eq. 2 sums under PointNormalTriangles::NotEdgeOn:
+ * \a normals with those of the triangles flagged in \a edge_on set to NaN, so that
+ * computeVertexNormals() and its variants skip them (their areas still count in A_p).
+ * Follow with fillMissingVertexNormals().
+ * \param[in] normals \#T triangle normals
+ * \param[in] edge_on \#T flags (markEdgeOnTriangles())
+ * \param[out] masked \#T normals
+ * \param[in] num_threads OpenMP threads, 0 = defaultThreads() */
+PCL_EXPORTS void maskEdgeOnNormals(const Vector3fVector& normals,
+                                   const std::vector<std::uint8_t>& edge_on,
+                                   Vector3fVector& masked,
+                                   int num_threads = 0);
+
+/** \brief The vertices that the masked normals (maskEdgeOnNormals()) left without a
+ * normal get eq. 2 over all their triangles: where every triangle at a vertex is seen
+ * edge-on, the paper's normal.
+ *
+ * Each vertex whose normal is NaN gets the normal computeVertexNormals() (rings = 1)
+ * or computeVertexNormalsOverRings() gives it from \a normals, bit for bit; it stays
+ * NaN where those give none. The other vertices are not touched.
+ * \param[in] triangles \#T triangles over vertex ids
+ * \param[in] normals \#T triangle normals, none masked
+ * \param[in] areas \#T triangle areas [m^2]
+ * \param[in] rings k >= 1, as the normals were computed with
+ * \param[in,out] vertex_normals \#V unit normals or NaN
+ * \param[in] num_threads OpenMP threads, 0 = defaultThreads() (the result does not
+ *            depend on it)
+ * \return the number of vertices given a normal */
+PCL_EXPORTS std::size_t fillMissingVertexNormals(const std::vector<Triangle>& triangles,
+                                                 const Vector3fVector& normals,
+                                                 const std::vector<double>& areas,
+                                                 int rings,
+                                                 Vector3fVector& vertex_normals,
+                                                 int num_threads = 0);
+
 /** \brief Triangle normals as the normalized mean of their vertices' normals.
  * \param[in] triangles \#T triangles over vertex ids
  * \param[in] vertex_normals \#V unit normals (NaN: no normal)

@@ -66,6 +66,19 @@ enum class SegmentNormalWeight : std::uint8_t {
   Area = 1
 };
 
+/** \brief Which of a point's triangles eq. 2 sums into its normal. */
+enum class PointNormalTriangles : std::uint8_t {
+  /** Every triangle at the point, as in the paper. */
+  All = 0,
+  /** The triangles not seen edge-on (more obliquely than max_view_incidence_angle,
+   * the test that already keeps them from being valid edge triangles), or all of them
+   * where every one is. A triangle whose three rays lie nearly in one plane through
+   * the sensor (a sliver in (theta, phi), as the straight rows of a pixel grid make
+   * along a border) is edge-on by construction: its normal is that plane's, not the
+   * surface's, and eq. 2's 1 / A_t gives it most of the weight. */
+  NotEdgeOn = 1
+};
+
 /** \brief Every parameter of SelectiveSegmentation, with the paper's defaults.
  *
  * Angles are in radians, lengths in metres (the cloud's unit). docs/parameters.md gives
@@ -105,6 +118,12 @@ struct PCL_EXPORTS SelectiveSegmentationParameters {
    * of the k-ring, which averages range noise over about k^2 times more triangles.
    * Valid: [1, 10]. See docs/parameters.md. */
   int normal_rings = 1;
+
+  /** \brief The triangles whose normals eq. 2 (or its k-ring version) sums. Default:
+   * all of them, as in the paper; NotEdgeOn leaves out those seen edge-on, which on a
+   * pixel grid's borders are slivers whose normals are not the surface's
+   * (docs/parameters.md). Has no effect with max_view_incidence_angle = pi/2. */
+  PointNormalTriangles point_normal_triangles = PointNormalTriangles::All;
 
   /** \brief The triangle normal tested by eq. 8 (valid edge triangles). Default: the
    * facet normal, as in the paper. */

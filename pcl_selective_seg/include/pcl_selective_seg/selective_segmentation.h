@@ -140,6 +140,17 @@ public:
   void setNormalRings(int rings) { params_.normal_rings = rings; }
   int getNormalRings() const { return params_.normal_rings; }
 
+  /** \brief The triangles eq. 2 sums into a point normal; default all of them (the
+   * paper). */
+  void setPointNormalTriangles(PointNormalTriangles which)
+  {
+    params_.point_normal_triangles = which;
+  }
+  PointNormalTriangles getPointNormalTriangles() const
+  {
+    return params_.point_normal_triangles;
+  }
+
   /** \brief Smallest voxel edge [m]; 0 = automatic (see the parameters). */
   void setMinVoxelSize(double size) { params_.min_voxel_size = size; }
   double getMinVoxelSize() const { return params_.min_voxel_size; }

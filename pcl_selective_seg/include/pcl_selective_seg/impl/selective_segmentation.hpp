@@ -168,9 +168,18 @@ SelectiveSegmentation<PointT>::computeNormals()
                                   triangle_edge_on_,
                                   params_.num_threads);
   vertex_areas_ = std::make_shared<std::vector<double>>();
+  // Eq. 2 over the triangles not seen edge-on, when asked, then over all of them where
+  // that leaves no normal.
+  const bool not_edge_on =
+      params_.point_normal_triangles == PointNormalTriangles::NotEdgeOn;
+  Vector3fVector masked;
+  if (not_edge_on)
+    maskEdgeOnNormals(
+        triangle_normals_, triangle_edge_on_, masked, params_.num_threads);
+  const Vector3fVector& eq2_normals = not_edge_on ? masked : triangle_normals_;
   computeVertexNormals(positions.size(),
                        tri.triangles,
-                       triangle_normals_,
+                       eq2_normals,
                        triangle_areas_,
                        vertex_normals_,
                        *vertex_areas_,
@@ -179,10 +188,17 @@ SelectiveSegmentation<PointT>::computeNormals()
   if (params_.normal_rings > 1)
     computeVertexNormalsOverRings(positions.size(),
                                   tri.triangles,
-                                  triangle_normals_,
+                                  eq2_normals,
                                   triangle_areas_,
                                   params_.normal_rings,
                                   vertex_normals_);
+  if (not_edge_on)
+    fillMissingVertexNormals(tri.triangles,
+                             triangle_normals_,
+                             triangle_areas_,
+                             params_.normal_rings,
+                             vertex_normals_,
+                             params_.num_threads);
   return publishNormals();
 }
 

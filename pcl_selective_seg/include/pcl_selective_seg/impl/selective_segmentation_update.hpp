@@ -102,6 +102,7 @@ SelectiveSegmentation<PointT>::updateMesh(std::size_t first_new_point, bool& fai
       params_.angle_quantization == mesh_params_.angle_quantization &&
       params_.max_view_incidence_angle == mesh_params_.max_view_incidence_angle &&
       params_.normal_rings == mesh_params_.normal_rings &&
+      params_.point_normal_triangles == mesh_params_.point_normal_triangles &&
       params_.delaunay_backend != DelaunayBackend::Vtk &&
       mesh_params_.delaunay_backend != DelaunayBackend::Vtk &&
       delaunay_.getSensorPose().matrix() == mesh_pose_ &&
@@ -225,9 +226,18 @@ SelectiveSegmentation<PointT>::updateNormals(const DelaunayInsertion& info,
     vertex_normals[info.old_to_new_point[v]] = vertex_normals_[v];
     (*vertex_areas)[info.old_to_new_point[v]] = (*vertex_areas_)[v];
   }
+  // As computeNormals(): a vertex's normal depends on its own triangles (its k-ring's)
+  // only, with or without the edge-on ones, so those of the changed triangles suffice.
+  const bool not_edge_on =
+      params_.point_normal_triangles == PointNormalTriangles::NotEdgeOn;
+  Vector3fVector masked;
+  if (not_edge_on)
+    maskEdgeOnNormals(
+        triangle_normals_, triangle_edge_on_, masked, params_.num_threads);
+  const Vector3fVector& eq2_normals = not_edge_on ? masked : triangle_normals_;
   updateVertexNormals(tri.triangles,
                       adjacency,
-                      triangle_normals_,
+                      eq2_normals,
                       triangle_areas_,
                       changed,
                       vertex_normals,
@@ -236,11 +246,18 @@ SelectiveSegmentation<PointT>::updateNormals(const DelaunayInsertion& info,
   if (params_.normal_rings > 1)
     updateVertexNormalsOverRings(tri.triangles,
                                  adjacency,
-                                 triangle_normals_,
+                                 eq2_normals,
                                  triangle_areas_,
                                  params_.normal_rings,
                                  changed,
                                  vertex_normals);
+  if (not_edge_on)
+    fillMissingVertexNormals(tri.triangles,
+                             triangle_normals_,
+                             triangle_areas_,
+                             params_.normal_rings,
+                             vertex_normals,
+                             params_.num_threads);
   // The vertices of the changed triangles; their voxels changed for the octree (the new
   // vertices are corners of new triangles).
   const bool note_changes = !previous_leaves_.leaves.empty();
