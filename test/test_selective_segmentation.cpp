@@ -745,6 +745,118 @@ TEST(SelectiveSegmentation, PolygonMeshIndexesTheInputCloud)
   }
 }
 
+TEST(SelectiveSegmentation, GettersDescribeTheLastRun)
+{
+  // After extract(), another input cloud, another sensor pose: the labeled cloud, the
+  // normals and the mesh still describe the run (its cloud, its pose), never a mix of
+  // the run's labels or triangles with the new cloud.
+  const auto cloud = cubeScene(3000, 4);
+  SelectiveSegmentation<pcl::PointXYZL> seg;
+  std::vector<pcl::PointIndices> clusters;
+  ASSERT_TRUE(segment<pcl::PointXYZL>(cloud, seg, clusters));
+  const auto labels = seg.getResult().labels;
+  SelectiveSegmentation<pcl::PointXYZL> twin;
+  ASSERT_TRUE(segment<pcl::PointXYZL>(cloud, twin, clusters));
+  const auto expected_normals = twin.getPointNormals();
+
+  auto other = pcl::make_shared<Labeled>(*cloud);
+  for (auto& p : *other)
+    p.z += 1.0f;
+  seg.setInputCloud(other); // same size, other points
+  Eigen::Affine3f pose = Eigen::Affine3f::Identity();
+  pose.rotate(Eigen::AngleAxisf(0.8f, Eigen::Vector3f::UnitY()));
+  seg.setSensorPose(pose);
+
+  const auto labeled = seg.getLabeledCloud();
+  ASSERT_TRUE(labeled);
+  ASSERT_EQ(labeled->size(), cloud->size());
+  for (std::size_t i = 0; i < cloud->size(); ++i) {
+    ASSERT_EQ((*labeled)[i].getVector3fMap(), (*cloud)[i].getVector3fMap()) << i;
+    ASSERT_EQ((*labeled)[i].label, labels[i]);
+  }
+  const auto normals = seg.getPointNormals();
+  ASSERT_TRUE(normals);
+  ASSERT_EQ(normals->size(), cloud->size());
+  for (std::size_t i = 0; i < cloud->size(); ++i) {
+    const Eigen::Vector3f a = (*normals)[i].getNormalVector3fMap();
+    const Eigen::Vector3f b = (*expected_normals)[i].getNormalVector3fMap();
+    ASSERT_TRUE(a == b || (!a.allFinite() && !b.allFinite())) << i;
+  }
+
+  // A smaller cloud: the mesh still indexes the run's cloud.
+  auto few = pcl::make_shared<Labeled>();
+  few->resize(10);
+  seg.setInputCloud(few);
+  pcl::PolygonMesh mesh;
+  seg.getPolygonMesh(mesh);
+  EXPECT_EQ(mesh.cloud.width * mesh.cloud.height, cloud->size());
+  ASSERT_EQ(mesh.polygons.size(), seg.getResult().mesh.triangles.size());
+  for (const auto& poly : mesh.polygons)
+    for (const auto v : poly.vertices)
+      ASSERT_LT(v, cloud->size());
+  ASSERT_TRUE(seg.getLabeledCloud());
+  EXPECT_EQ(seg.getLabeledCloud()->size(), cloud->size());
+}
+
+TEST(SelectiveSegmentation, CloudWhoseLayoutIsNotItsSize)
+{
+  // Points appended to an organized cloud's vector leave width x height short of its
+  // size: the outputs take every point, in one row (they wrote past the end before).
+  auto cloud = wall(20, 40);
+  for (int i = 0; i < 30; ++i)
+    cloud->points.emplace_back(0.01f * static_cast<float>(i), 0.3f, 2.5f);
+  ASSERT_NE(static_cast<std::size_t>(cloud->width) * cloud->height, cloud->size());
+  SelectiveSegmentation<pcl::PointXYZ> seg;
+  std::vector<pcl::PointIndices> clusters;
+  ASSERT_TRUE(segment<pcl::PointXYZ>(cloud, seg, clusters));
+  const auto labeled = seg.getLabeledCloud();
+  ASSERT_TRUE(labeled);
+  EXPECT_EQ(labeled->size(), cloud->size());
+  EXPECT_EQ(labeled->width, cloud->size());
+  EXPECT_EQ(labeled->height, 1u);
+  for (std::size_t i = 0; i < cloud->size(); ++i)
+    ASSERT_EQ((*labeled)[i].label, seg.getResult().labels[i]);
+  const auto normals = seg.getPointNormals();
+  ASSERT_TRUE(normals);
+  EXPECT_EQ(normals->size(), cloud->size());
+  EXPECT_EQ(normals->height, 1u);
+  EXPECT_TRUE((*normals)[cloud->size() - 1].getNormalVector3fMap().allFinite());
+}
+
+TEST(SelectiveSegmentation, SensorPoseMustBeARotationAndATranslation)
+{
+  const auto cloud = wall(20, 20);
+  SelectiveSegmentation<pcl::PointXYZ> seg;
+  std::vector<pcl::PointIndices> clusters;
+  // A zero quaternion (normalized() leaves it as it is, and its matrix is the
+  // identity) and a non-finite one are refused, not read as the identity.
+  for (const Eigen::Quaternionf q :
+       {Eigen::Quaternionf(0.f, 0.f, 0.f, 0.f),
+        Eigen::Quaternionf(std::numeric_limits<float>::quiet_NaN(), 0.f, 0.f, 0.f)}) {
+    auto posed = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>(*cloud);
+    posed->sensor_orientation_ = q;
+    EXPECT_FALSE(segment<pcl::PointXYZ>(posed, seg, clusters));
+    EXPECT_TRUE(clusters.empty());
+  }
+  // An unnormalized quaternion is a rotation: (2, 0, 0, 0) is the identity.
+  auto posed = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>(*cloud);
+  posed->sensor_orientation_ = Eigen::Quaternionf(2.f, 0.f, 0.f, 0.f);
+  ASSERT_TRUE(segment<pcl::PointXYZ>(posed, seg, clusters));
+  EXPECT_EQ(clusters.size(), 1u);
+  // A scaled, a mirrored or a non-finite pose given to setSensorPose() is refused.
+  Eigen::Affine3f scaled = Eigen::Affine3f::Identity();
+  scaled.scale(2.0f);
+  Eigen::Affine3f mirrored = Eigen::Affine3f::Identity();
+  mirrored.linear()(0, 0) = -1.0f;
+  Eigen::Affine3f moved_to_nan = Eigen::Affine3f::Identity();
+  moved_to_nan.translation().x() = std::numeric_limits<float>::quiet_NaN();
+  for (const auto& pose : {scaled, mirrored, moved_to_nan}) {
+    seg.setSensorPose(pose);
+    EXPECT_FALSE(segment<pcl::PointXYZ>(cloud, seg, clusters));
+    EXPECT_FALSE(seg.getLabeledCloud());
+  }
+}
+
 TEST(SelectiveSegmentation, VtkBackendSegmentsTheCubeScene)
 {
   using pcl::selective_seg::DelaunayBackend;

@@ -217,18 +217,22 @@ public:
    * or update(). */
   const SegmentationResult& getResult() const { return result_; }
 
-  /** \brief The input's points with their labels (0 = unlabeled); same size, order
-   * and layout (width, height) as the input. Null before a successful extract(). */
+  /** \brief The points of the last run's input cloud with their labels (0 =
+   * unlabeled); same size, order and layout (width, height) as that cloud (one row
+   * when its width x height is not its size). Null before a successful extract().
+   * The getters describe the last extract() or update(), whatever the input, pose or
+   * parameters set since. */
   LabeledCloud::Ptr getLabeledCloud() const;
 
-  /** \brief Point normals (eq. 2) in the cloud frame, oriented toward the sensor; same
-   * size and layout as the input; NaN where a point has no normal. Null before a
-   * successful extract(). Built from the vertex normals on the first call after a run
-   * (the pipeline itself needs only the vertex normals), then kept. */
+  /** \brief Point normals (eq. 2) in the cloud frame of the last run (its sensor
+   * pose), oriented toward the sensor; same size and layout as getLabeledCloud(); NaN
+   * where a point has no normal. Null before a successful extract(). Built from the
+   * vertex normals on the first call after a run (the pipeline itself needs only the
+   * vertex normals), then kept. */
   NormalCloud::ConstPtr getPointNormals() const;
 
-  /** \brief The segmented mesh over the input cloud (labels and classes per triangle
-   * are in getResult().mesh). */
+  /** \brief The segmented mesh over the last run's input cloud (labels and classes
+   * per triangle are in getResult().mesh); empty before a successful extract(). */
   void getPolygonMesh(pcl::PolygonMesh& mesh) const;
 
   /** \brief The triangulation of the last extract(): the vertex of every input point,
@@ -319,6 +323,12 @@ protected:
 
   /** \brief Fail: report, clear the outputs, keep the point counts. */
   bool fail(const char* stage, const std::string& why);
+
+  /** \brief An output cloud of the last run's size, layout and header, every point
+   * \a fill. */
+  template <typename CloudT>
+  pcl::shared_ptr<CloudT>
+  cloudShapedLikeTheRun(const typename CloudT::PointType& fill) const;
 
 private:
   SelectiveSegmentationParameters params_;

@@ -14,6 +14,7 @@
 #include <pcl/surface/reconstruction.h>
 
 #include <algorithm>
+#include <string>
 #include <vector>
 
 namespace pcl {
@@ -129,6 +130,10 @@ public:
   void resetSensorPose() { has_sensor_pose_ = false; }
   /** \brief The pose in use: the override, or the input cloud's (identity if none). */
   Eigen::Affine3f getSensorPose() const;
+  /** \brief Whether the pose in use is a finite rotation (within 1e-4) and
+   * translation; triangulate() refuses any other. \param[out] why the reason when
+   * not, if non-null. */
+  bool sensorPoseIsRigid(std::string* why = nullptr) const;
 
   /** \brief Guarded: the base class dereferences a missing input. */
   void reconstruct(pcl::PolygonMesh& output) override;

@@ -692,22 +692,39 @@ SelectiveSegmentation<PointT>::segmentMesh(std::vector<pcl::PointIndices>& clust
 }
 
 template <typename PointT>
+template <typename CloudT>
+pcl::shared_ptr<CloudT>
+SelectiveSegmentation<PointT>::cloudShapedLikeTheRun(
+    const typename CloudT::PointType& fill) const
+{
+  const PointCloud& run = *mesh_input_;
+  auto out = pcl::make_shared<CloudT>();
+  // The run's layout when it is one (width x height = size: a cloud whose points were
+  // pushed after it was loaded may not be), else one row.
+  if (static_cast<std::size_t>(run.width) * run.height == run.size())
+    *out = CloudT(run.width, run.height, fill);
+  else
+    out->resize(run.size(), fill);
+  out->header = run.header;
+  return out;
+}
+
+template <typename PointT>
 typename SelectiveSegmentation<PointT>::NormalCloud::ConstPtr
 SelectiveSegmentation<PointT>::getPointNormals() const
 {
   if (normals_)
     return normals_;
   const SphericalTriangulation& tri = delaunay_.getTriangulation();
-  if (!input_ || result_.labels.size() != input_->size() ||
-      tri.point_vertex.size() != input_->size() || vertex_normals_.empty())
+  if (!mesh_input_ || result_.labels.size() != mesh_input_->size() ||
+      tri.point_vertex.size() != mesh_input_->size() || vertex_normals_.empty())
     return nullptr;
   const float nan = std::numeric_limits<float>::quiet_NaN();
-  auto normals = pcl::make_shared<NormalCloud>(
-      input_->width, input_->height, pcl::Normal(nan, nan, nan, nan));
-  normals->header = input_->header;
+  auto normals = cloudShapedLikeTheRun<NormalCloud>(pcl::Normal(nan, nan, nan, nan));
   normals->is_dense = false;
-  const Eigen::Matrix3f to_cloud = sensorToCloud();
-  for (std::size_t i = 0; i < input_->size(); ++i) {
+  // The orientation of the run, whatever the pose is now.
+  const Eigen::Matrix3f to_cloud = mesh_pose_.template topLeftCorner<3, 3>();
+  for (std::size_t i = 0; i < mesh_input_->size(); ++i) {
     const pcl::index_t v = tri.point_vertex[i];
     if (v < 0 || !vertex_normals_[v].allFinite())
       continue;
@@ -723,15 +740,16 @@ typename SelectiveSegmentation<PointT>::LabeledCloud::Ptr
 SelectiveSegmentation<PointT>::getLabeledCloud() const
 {
   // A successful run has at least one segment.
-  if (!input_ || result_.segments.empty() || result_.labels.size() != input_->size())
+  if (!mesh_input_ || result_.segments.empty() ||
+      result_.labels.size() != mesh_input_->size())
     return nullptr;
-  auto out = pcl::make_shared<LabeledCloud>(input_->width, input_->height);
-  out->header = input_->header;
-  out->is_dense = input_->is_dense;
-  out->sensor_origin_ = input_->sensor_origin_;
-  out->sensor_orientation_ = input_->sensor_orientation_;
-  for (std::size_t i = 0; i < input_->size(); ++i) {
-    (*out)[i].getVector3fMap() = (*input_)[i].getVector3fMap();
+  const PointCloud& run = *mesh_input_;
+  auto out = cloudShapedLikeTheRun<LabeledCloud>(pcl::PointXYZL());
+  out->is_dense = run.is_dense;
+  out->sensor_origin_ = run.sensor_origin_;
+  out->sensor_orientation_ = run.sensor_orientation_;
+  for (std::size_t i = 0; i < run.size(); ++i) {
+    (*out)[i].getVector3fMap() = run[i].getVector3fMap();
     (*out)[i].label = result_.labels[i];
   }
   return out;
@@ -742,10 +760,11 @@ void
 SelectiveSegmentation<PointT>::getPolygonMesh(pcl::PolygonMesh& mesh) const
 {
   mesh = pcl::PolygonMesh();
-  if (!input_ || result_.segments.empty())
+  if (!mesh_input_ || result_.segments.empty() ||
+      result_.labels.size() != mesh_input_->size())
     return;
-  pcl::toPCLPointCloud2(*input_, mesh.cloud);
-  mesh.header = input_->header;
+  pcl::toPCLPointCloud2(*mesh_input_, mesh.cloud);
+  mesh.header = mesh_input_->header;
   mesh.polygons.resize(result_.mesh.triangles.size());
   for (std::size_t t = 0; t < mesh.polygons.size(); ++t) {
     const Triangle& tri = result_.mesh.triangles[t];

@@ -95,6 +95,37 @@ SphericalDelaunay<PointT>::getSensorPose() const
 }
 
 template <typename PointT>
+bool
+SphericalDelaunay<PointT>::sensorPoseIsRigid(std::string* why) const
+{
+  if (!has_sensor_pose_ && this->input_) {
+    // normalized() leaves a zero quaternion as it is, whose matrix is the identity.
+    const float norm = this->input_->sensor_orientation_.coeffs().norm();
+    if (!(norm >= 1e-6f) || !std::isfinite(norm)) {
+      if (why)
+        *why = "the cloud's sensor_orientation_ has norm " + std::to_string(norm) +
+               ": not a rotation (set a unit quaternion, or setSensorPose())";
+      return false;
+    }
+  }
+  const Eigen::Affine3f pose = getSensorPose();
+  const Eigen::Matrix3f r = pose.linear();
+  // toSensorFrame() inverts the rotation by its transpose: a scaled or sheared pose
+  // would map the points wrongly.
+  const bool rigid =
+      pose.matrix().allFinite() &&
+      (r.transpose() * r - Eigen::Matrix3f::Identity()).cwiseAbs().maxCoeff() <=
+          1e-4f &&
+      r.determinant() > 0.0f;
+  if (!rigid && why)
+    *why = std::string(has_sensor_pose_
+                           ? "the pose given to setSensorPose()"
+                           : "the cloud's sensor_origin_ / sensor_orientation_") +
+           " is not a finite rotation and translation";
+  return rigid;
+}
+
+template <typename PointT>
 Eigen::Vector3d
 SphericalDelaunay<PointT>::toSensorFrame(const Eigen::Affine3d& pose,
                                          pcl::index_t index) const
@@ -272,6 +303,13 @@ SphericalDelaunay<PointT>::triangulate()
               "outside [2.5e-8, 1e-2]\n",
               getClassName().c_str(),
               angle_quantization_);
+    return false;
+  }
+  std::string bad_pose;
+  if (!sensorPoseIsRigid(&bad_pose)) {
+    PCL_ERROR("[pcl::selective_seg::%s::triangulate] %s\n",
+              getClassName().c_str(),
+              bad_pose.c_str());
     return false;
   }
   if (!this->initCompute())
