@@ -204,6 +204,7 @@ TEST_F(Tool, BadOptionsAreUsageErrors)
   EXPECT_EQ(run(in + " -merge_deg -5"), 2);
   EXPECT_EQ(run(in + " -min_voxel_m nan"), 2);
   EXPECT_EQ(run(in + " -backend cgal"), 2);
+  EXPECT_EQ(run(in + " -normal_triangles some"), 2);
   EXPECT_EQ(run(in + " -no_such_option"), 2);
   EXPECT_EQ(run(in + " -sensor_origin 1,2"), 2);
   EXPECT_EQ(run(in + " -unit_scale 0"), 2);
@@ -219,6 +220,30 @@ TEST_F(Tool, BadOptionsAreUsageErrors)
   EXPECT_EQ(run(""), 2);
   EXPECT_EQ(run("-h"), 0);
   EXPECT_EQ(files(), 0u);
+}
+
+TEST_F(Tool, SummaryRecordsEveryParameter)
+{
+  // A summary says how it was made: every segmentation option, given or default.
+  ASSERT_EQ(run("'" + scan + "' -ignore_viewpoint -json " + out("summary.json") +
+                " -spread_frame mean_normal -segment_weight area -normal_rings 2"
+                " -normal_triangles not_edge_on -edge_normal vertex_mean"
+                " -voxel_factor 3 -max_depth 12 -angle_step_rad 2e-7"),
+            0);
+  const std::string text = fileBytes(out("summary.json"));
+  for (const char* entry : {"\"split_deg\": 7.6",
+                            "\"incidence_deg\": 85",
+                            "\"spread_frame\": \"mean_normal\"",
+                            "\"segment_weight\": \"area\"",
+                            "\"normal_rings\": 2",
+                            "\"normal_triangles\": \"not_edge_on\"",
+                            "\"edge_normal\": \"vertex_mean\"",
+                            "\"voxel_factor\": 3",
+                            "\"min_split_points\": 8",
+                            "\"max_depth\": 12",
+                            "\"angle_step_rad\": 2e-07",
+                            "\"backend\": \"sweep\""})
+    EXPECT_NE(text.find(entry), std::string::npos) << entry;
 }
 
 TEST_F(Tool, ThreadCountKeepsTheOutput)

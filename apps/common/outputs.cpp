@@ -56,7 +56,11 @@ POINT_CLOUD_REGISTER_POINT_STRUCT(
 namespace selseg_apps {
 namespace {
 
+using pcl::selective_seg::EdgeTriangleNormal;
+using pcl::selective_seg::NormalSpreadFrame;
+using pcl::selective_seg::PointNormalTriangles;
 using pcl::selective_seg::SegmentedMesh;
+using pcl::selective_seg::SegmentNormalWeight;
 
 /** The vertices the triangles use, numbered densely in the order of their first use. */
 struct CompactMesh {
@@ -664,8 +668,24 @@ writeSummaryJson(const std::string& path,
       << ", \"merge_deg\": " << p.max_merge_angle * deg
       << ", \"edge_deg\": " << p.max_edge_triangle_angle * deg
       << ", \"incidence_deg\": " << p.max_view_incidence_angle * deg
+      << ", \"spread_frame\": "
+      << (p.normal_spread_frame == NormalSpreadFrame::MeanNormal ? "\"mean_normal\""
+                                                                 : "\"sensor\"")
+      << ", \"segment_weight\": "
+      << (p.segment_normal_weight == SegmentNormalWeight::Area ? "\"area\""
+                                                               : "\"inverse_area\"")
+      << ", \"normal_rings\": " << p.normal_rings << ", \"normal_triangles\": "
+      << (p.point_normal_triangles == PointNormalTriangles::NotEdgeOn
+              ? "\"not_edge_on\""
+              : "\"all\"")
+      << ", \"edge_normal\": "
+      << (p.edge_triangle_normal == EdgeTriangleNormal::VertexMean ? "\"vertex_mean\""
+                                                                   : "\"facet\"")
       << ", \"min_voxel_m\": " << r.min_voxel_size
+      << ", \"voxel_factor\": " << p.min_voxel_size_factor
       << ", \"min_split_points\": " << p.min_points_to_split
+      << ", \"max_depth\": " << p.max_octree_depth
+      << ", \"angle_step_rad\": " << p.angle_quantization
       << ", \"backend\": " << jsonString(info.backend) << "},\n  \"counts\": {"
       << "\"labeled\": " << c.labeled << ", \"shared_vertex\": " << c.shared_vertex
       << ", \"non_finite\": " << c.non_finite
