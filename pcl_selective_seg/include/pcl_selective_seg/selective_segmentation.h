@@ -324,6 +324,11 @@ protected:
   /** \brief Fail: report, clear the outputs, keep the point counts. */
   bool fail(const char* stage, const std::string& why);
 
+  /** \brief The triangle normals eq. 2 sums: triangle_normals_, or with
+   * PointNormalTriangles::NotEdgeOn a copy in \a masked without the edge-on ones
+   * (maskEdgeOnNormals(); follow with fillMissingVertexNormals()). */
+  const Vector3fVector& eq2TriangleNormals(Vector3fVector& masked) const;
+
   /** \brief An output cloud of the last run's size, layout and header, every point
    * \a fill. */
   template <typename CloudT>

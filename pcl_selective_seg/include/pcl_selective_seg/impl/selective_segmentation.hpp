@@ -170,13 +170,8 @@ SelectiveSegmentation<PointT>::computeNormals()
   vertex_areas_ = std::make_shared<std::vector<double>>();
   // Eq. 2 over the triangles not seen edge-on, when asked, then over all of them where
   // that leaves no normal.
-  const bool not_edge_on =
-      params_.point_normal_triangles == PointNormalTriangles::NotEdgeOn;
   Vector3fVector masked;
-  if (not_edge_on)
-    maskEdgeOnNormals(
-        triangle_normals_, triangle_edge_on_, masked, params_.num_threads);
-  const Vector3fVector& eq2_normals = not_edge_on ? masked : triangle_normals_;
+  const Vector3fVector& eq2_normals = eq2TriangleNormals(masked);
   computeVertexNormals(positions.size(),
                        tri.triangles,
                        eq2_normals,
@@ -192,7 +187,7 @@ SelectiveSegmentation<PointT>::computeNormals()
                                   triangle_areas_,
                                   params_.normal_rings,
                                   vertex_normals_);
-  if (not_edge_on)
+  if (&eq2_normals == &masked)
     fillMissingVertexNormals(tri.triangles,
                              triangle_normals_,
                              triangle_areas_,
@@ -200,6 +195,16 @@ SelectiveSegmentation<PointT>::computeNormals()
                              vertex_normals_,
                              params_.num_threads);
   return publishNormals();
+}
+
+template <typename PointT>
+const Vector3fVector&
+SelectiveSegmentation<PointT>::eq2TriangleNormals(Vector3fVector& masked) const
+{
+  if (params_.point_normal_triangles != PointNormalTriangles::NotEdgeOn)
+    return triangle_normals_;
+  maskEdgeOnNormals(triangle_normals_, triangle_edge_on_, masked, params_.num_threads);
+  return masked;
 }
 
 template <typename PointT>

@@ -228,13 +228,8 @@ SelectiveSegmentation<PointT>::updateNormals(const DelaunayInsertion& info,
   }
   // As computeNormals(): a vertex's normal depends on its own triangles (its k-ring's)
   // only, with or without the edge-on ones, so those of the changed triangles suffice.
-  const bool not_edge_on =
-      params_.point_normal_triangles == PointNormalTriangles::NotEdgeOn;
   Vector3fVector masked;
-  if (not_edge_on)
-    maskEdgeOnNormals(
-        triangle_normals_, triangle_edge_on_, masked, params_.num_threads);
-  const Vector3fVector& eq2_normals = not_edge_on ? masked : triangle_normals_;
+  const Vector3fVector& eq2_normals = eq2TriangleNormals(masked);
   updateVertexNormals(tri.triangles,
                       adjacency,
                       eq2_normals,
@@ -251,7 +246,7 @@ SelectiveSegmentation<PointT>::updateNormals(const DelaunayInsertion& info,
                                  params_.normal_rings,
                                  changed,
                                  vertex_normals);
-  if (not_edge_on)
+  if (&eq2_normals == &masked)
     fillMissingVertexNormals(tri.triangles,
                              triangle_normals_,
                              triangle_areas_,
