@@ -11,7 +11,8 @@
 // slot set (and not every parameter overridden), it also checks update(): extract() on
 // the first three quarters of the points, update() with the rest, must give exactly
 // extract() on the union with the first run's finest voxel
-// (docs/incremental_update.md).
+// (docs/incremental_update.md). With bit 2 set the cloud declares a layout that is not
+// its size; the getters must still give one output point per input point.
 //
 // Input layout (all little endian; missing bytes read as zero):
 //   byte 0        point encoding: 0 raw float32 x y z; 1 int8 grid (x/16, y/16,
@@ -261,6 +262,12 @@ LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size)
     cloud->push_back(q);
   }
   cloud->is_dense = false;
+  // Bit 2 of the last slot: a layout that is not the size (points pushed into the
+  // vector of an organized cloud), which the getters must not trust.
+  if ((slot[12] & 4) != 0 && !cloud->empty()) {
+    cloud->width = static_cast<std::uint32_t>(cloud->size() / 2 + 1);
+    cloud->height = 2;
+  }
 
   SelectiveSegmentation<pcl::PointXYZ> seg;
   seg.setParameters(p);
@@ -315,6 +322,24 @@ LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size)
     check(leaf.label >= 1 && leaf.label <= r.segments.size() && leaf.normal.allFinite(),
           "leaf label or normal");
   check(std::isfinite(r.min_voxel_size) && r.min_voxel_size > 0.0, "voxel size");
+  // The getters: one output point per input point, whatever the declared layout.
+  const auto labeled_cloud = seg.getLabeledCloud();
+  check(labeled_cloud && labeled_cloud->size() == cloud->size(), "labeled cloud size");
+  for (std::size_t i = 0; i < cloud->size(); ++i)
+    check((*labeled_cloud)[i].label == r.labels[i], "labeled cloud label");
+  const auto normals = seg.getPointNormals();
+  check(normals && normals->size() == cloud->size(), "normal cloud size");
+  for (std::size_t i = 0; i < cloud->size(); ++i) {
+    const Eigen::Vector3f n = (*normals)[i].getNormalVector3fMap();
+    check(r.labels[i] == 0 || std::abs(n.norm() - 1.0f) < 1e-3f,
+          "labeled point normal");
+  }
+  pcl::PolygonMesh mesh;
+  seg.getPolygonMesh(mesh);
+  check(mesh.polygons.size() == r.mesh.triangles.size() &&
+            static_cast<std::size_t>(mesh.cloud.width) * mesh.cloud.height ==
+                cloud->size(),
+        "polygon mesh");
   if (check_update)
     checkUpdate(*cloud, p, pose_bytes != 0 ? &pose : nullptr);
   return 0;
