@@ -62,6 +62,10 @@ printHelp(const char* program)
   print_info("  -density_ratio X     densest / sparsest angular density [-], in "
              "[1, 100] (default %g)\n",
              d.density_ratio);
+  print_info(
+      "  -jitter X            jitter of each ray in its grid cell [-], in [0, 1]: "
+      "0 = a regular grid, as a depth camera's pixels (default %g)\n",
+      d.jitter);
   print_info("  -dropout P           probability that a ray returns nothing [-], in "
              "[0, 1) (default %g)\n",
              d.dropout);
@@ -101,6 +105,7 @@ checkArguments(int argc, char** argv)
                                       "-density",
                                       "-noise",
                                       "-density_ratio",
+                                      "-jitter",
                                       "-dropout",
                                       "-holes",
                                       "-hole_radius_deg",
@@ -147,6 +152,7 @@ parseOptions(int argc, char** argv, Options& opt)
   if (!parseNumber(argc, argv, "-density", opt.density) ||
       !parseNumber(argc, argv, "-noise", s.range_noise) ||
       !parseNumber(argc, argv, "-density_ratio", s.density_ratio) ||
+      !parseNumber(argc, argv, "-jitter", s.jitter) ||
       !parseNumber(argc, argv, "-dropout", s.dropout) ||
       !parseInteger(argc, argv, "-holes", 0.0, 1000.0, holes) ||
       !parseNumber(argc, argv, "-hole_radius_deg", hole_radius_deg) ||

@@ -14,6 +14,8 @@ expect(2 "Unknown argument '-bogus'" -bogus 1)
 expect(2 "needs a value > 0" -density 0)
 expect(2 "Option -hole_radius_deg needs a value in \\[0, 57.29\\]" -hole_radius_deg 57.3)
 expect(0 "" -hole_radius_deg 57.29)
+expect(2 "jitter" -jitter 1.5)
+expect(2 "jitter" -jitter -0.1)
 # A repeated option (the first value was used silently).
 expect(2 "Option -density is given more than once" -density 2 -density 3)
 expect(2 "Option -o is given more than once" -o a.pcd -o b.pcd)
