@@ -126,8 +126,8 @@ printSegmentationHelp()
              "paper's eq. 2 (default %d)\n",
              d.normal_rings);
   print_info("  -normal_triangles NAME triangles summed into a point normal (eq. 2): "
-             "all (paper) or not_edge_on (those within -incidence_deg of the line of "
-             "sight, all where none is) (default all)\n");
+             "all (paper) or not_edge_on (only those seen within -incidence_deg of "
+             "head-on; all where none is) (default all)\n");
   print_info("  -edge_normal NAME      normal tested by eq. 8: facet (paper) or "
              "vertex_mean (noise-robust) (default facet)\n");
   print_info("  -min_voxel_m X         smallest octree voxel [m]; 0 = automatic "
