@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <limits>
 #include <random>
 #include <set>
 
@@ -246,8 +247,25 @@ TEST(DelaunayInsertion, RejectsBadInputWithoutChangingIt)
       neighbours,
       {{pcl::selective_seg::kMaxDelaunayCoordinate + 1, 0}},
       info)); // out of range
+  // INT_MIN: std::abs() of it is undefined (it passed the range check).
+  EXPECT_FALSE(pcl::selective_seg::insertDelaunayPoints(
+      points,
+      triangles,
+      neighbours,
+      {{std::numeric_limits<std::int32_t>::min(), 0}},
+      info));
   EXPECT_EQ(points, p0);
   EXPECT_EQ(triangles, t0);
+  // An old point out of range (not from delaunay2d(), which refuses it).
+  {
+    Points far = {{std::numeric_limits<std::int32_t>::min(), 0}, {0, 10}, {10, 0}};
+    auto far_triangles = triangles;
+    auto far_neighbours = neighbours;
+    std::string far_why;
+    EXPECT_FALSE(pcl::selective_seg::insertDelaunayPoints(
+        far, far_triangles, far_neighbours, {{5, 2}}, info, &far_why));
+    EXPECT_NE(far_why.find("out of range"), std::string::npos) << far_why;
+  }
   // Nothing to insert: the identity.
   EXPECT_TRUE(
       pcl::selective_seg::insertDelaunayPoints(points, triangles, neighbours, {}, info));

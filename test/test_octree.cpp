@@ -181,7 +181,9 @@ validPoints(const Scene& scene)
   std::vector<pcl::index_t> valid;
   for (std::size_t i = 0; i < scene.cloud->size(); ++i)
     if (pcl::isFinite((*scene.cloud)[i]) && pcl::isNormalFinite((*scene.normals)[i]) &&
-        std::isfinite((*scene.areas)[i]) && (*scene.areas)[i] > 0.0)
+        (*scene.normals)[i].getNormalVector3fMap().squaredNorm() > 0.0f &&
+        std::isfinite((*scene.areas)[i]) && (*scene.areas)[i] > 0.0 &&
+        std::isfinite(1.0 / (*scene.areas)[i]))
       valid.push_back(static_cast<pcl::index_t>(i));
   return valid;
 }
@@ -566,8 +568,12 @@ TEST(OctreePointCloudNormalVariance, InvalidPointsSkipped)
   (*scene.areas)[12] = std::numeric_limits<double>::infinity();
   (*scene.areas)[13] = std::numeric_limits<double>::quiet_NaN();
   (*scene.cloud)[20].x = nan;
+  // A zero normal has no direction; a subnormal area an infinite weight 1 / A_p (the
+  // leaf normal was NaN).
+  (*scene.normals)[4].getNormalVector3fMap().setZero();
+  (*scene.areas)[14] = 1e-320;
   const auto valid = validPoints(scene);
-  ASSERT_EQ(valid.size(), scene.cloud->size() - 6);
+  ASSERT_EQ(valid.size(), scene.cloud->size() - 8);
   const auto octree = buildOctree(scene, 0.05, kPaperThreshold);
   expectPartition(*octree, valid);
 
@@ -583,6 +589,62 @@ TEST(OctreePointCloudNormalVariance, InvalidPointsSkipped)
                         valid.end(),
                         std::back_inserter(expected));
   expectPartition(*subset, expected);
+  for (const auto& leaf : octree->getAdaptiveLeaves())
+    EXPECT_TRUE(leaf.normal.allFinite() && std::isfinite(leaf.area));
+}
+
+TEST(OctreePointCloudNormalVariance, PointsFromPclsOwnInsertionAreRefused)
+{
+  // OctreePointCloud's insertion methods are not virtual: called through a base
+  // reference, or addPointToCloud(), they add points this class never checked, here
+  // points without normals and areas. computeAdaptiveLeaves() read past the end of
+  // both arrays; it now refuses the tree.
+  Scene scene = ridge();
+  auto normals = pcl::make_shared<pcl::PointCloud<pcl::Normal>>(*scene.normals);
+  auto areas = std::make_shared<std::vector<double>>(*scene.areas);
+  normals->resize(normals->size() / 3);
+  areas->resize(areas->size() / 3);
+  {
+    Octree octree(0.05);
+    octree.setInputCloud(scene.cloud);
+    octree.setInputNormals(normals, areas);
+    Octree::OctreeT& base = octree;
+    base.addPointsFromInputCloud();
+    octree.computeAdaptiveLeaves(kPaperThreshold, kMinPoints);
+    EXPECT_TRUE(octree.getAdaptiveLeaves().empty());
+    EXPECT_TRUE(octree.getOrderedIndices().empty());
+  }
+  {
+    auto cloud = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>(*scene.cloud);
+    cloud->resize(normals->size());
+    Octree octree(0.05);
+    octree.setInputCloud(cloud);
+    octree.setInputNormals(normals, areas);
+    ASSERT_TRUE(octree.addPointsFromInputCloud());
+    octree.computeAdaptiveLeaves(kPaperThreshold, kMinPoints);
+    ASSERT_FALSE(octree.getAdaptiveLeaves().empty());
+    octree.addPointToCloud((*scene.cloud)[cloud->size()], cloud); // no normal
+    octree.computeAdaptiveLeaves(kPaperThreshold, kMinPoints);
+    EXPECT_TRUE(octree.getAdaptiveLeaves().empty());
+  }
+}
+
+TEST(OctreePointCloudNormalVariance, ResolutionMustBePositiveAndFinite)
+{
+  const Scene scene = ridge();
+  for (const double resolution : {-1.0,
+                                  0.0,
+                                  std::numeric_limits<double>::infinity(),
+                                  std::numeric_limits<double>::quiet_NaN()}) {
+    SCOPED_TRACE(resolution);
+    Octree octree(0.05);
+    octree.setResolution(resolution);
+    octree.setInputCloud(scene.cloud);
+    octree.setInputNormals(scene.normals, scene.areas);
+    EXPECT_FALSE(octree.addPointsFromInputCloud());
+    octree.computeAdaptiveLeaves(kPaperThreshold, kMinPoints);
+    EXPECT_TRUE(octree.getAdaptiveLeaves().empty());
+  }
 }
 
 /** Every field of two trees' leaves and orderings, bit for bit. */
@@ -1146,4 +1208,19 @@ TEST(OctreePointCloudNormalVariance, SecondInsertionKeepsTheBox)
   EXPECT_TRUE((before == after).all());
   EXPECT_EQ(octree.getLeafCount(), leaves);
   EXPECT_EQ(pointsOutsideTheirVoxel(octree), 0u);
+}
+
+TEST(OctreePointCloudNormalVariance, DeleteTreeDeletesTheLeaves)
+{
+  const Scene scene = ridge();
+  auto octree = buildOctree(scene, 0.05, kPaperThreshold);
+  ASSERT_FALSE(octree->getAdaptiveLeaves().empty());
+  octree->deleteTree();
+  EXPECT_TRUE(octree->getAdaptiveLeaves().empty());
+  EXPECT_TRUE(octree->getOrderedIndices().empty());
+  EXPECT_EQ(octree->getLeafCount(), 0u);
+  // And the tree can be filled again: the same leaves as a new one.
+  ASSERT_TRUE(octree->addPointsFromInputCloud());
+  octree->computeAdaptiveLeaves(kPaperThreshold, kMinPoints);
+  expectSameLeaves(*octree, *buildOctree(scene, 0.05, kPaperThreshold));
 }

@@ -197,6 +197,29 @@ TEST(MergeSeedSegments, SimilarSeedsMergeAcrossValidEdge)
   EXPECT_NEAR(angleDeg(m.segment_normals[0], tilted(5.0)), 0.0, 1e-3);
 }
 
+TEST(MergeSeedSegments, MissingOrMismatchedArraysGiveEmptyOutputs)
+{
+  const Strip strip({0, 0, 1, 1}, {0.0, 10.0}, {1.0, 1.0});
+  const MergeInput good = strip.input();
+  Vector3fVector one_normal(1, Eigen::Vector3f(0.f, 0.f, -1.f));
+  std::vector<std::uint8_t> short_flags(1, 0);
+  std::vector<MergeInput> bad(5, good);
+  bad[0].vertex_leaf = nullptr;
+  bad[1].triangles = nullptr;
+  bad[2].leaf_areas = nullptr;
+  bad[3].triangle_normals = &one_normal;
+  bad[4].triangle_edge_on = &short_flags;
+  for (std::size_t k = 0; k < bad.size(); ++k) {
+    SCOPED_TRACE(k);
+    std::vector<pcl::index_t> leaf_segment{7};
+    Vector3fVector segment_normals(3);
+    mergeSeedSegments(bad[k], leaf_segment, segment_normals);
+    EXPECT_TRUE(leaf_segment.empty());
+    EXPECT_TRUE(segment_normals.empty());
+  }
+  EXPECT_EQ(merge(good).leaf_segment, (Segments{0, 0}));
+}
+
 TEST(MergeSeedSegments, DissimilarSeedsStaySeparate)
 {
   // eq. 9: 30 degrees > 25. The joining triangles (15 degrees) are valid for both.

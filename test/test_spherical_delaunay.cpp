@@ -23,6 +23,7 @@
 #include <set>
 #include <vector>
 
+using pcl::selective_seg::DelaunayInsertion;
 using pcl::selective_seg::kBehindSensor;
 using pcl::selective_seg::kNonFinite;
 using pcl::selective_seg::kOutsideIndices;
@@ -284,6 +285,45 @@ TEST(SphericalDelaunay, SensorPose)
   delaunay.resetSensorPose();
   ASSERT_TRUE(delaunay.triangulate());
   EXPECT_NE(delaunay.getTriangulation().vertex_angles, expected.vertex_angles);
+}
+
+TEST(SphericalDelaunay, PoseMustBeARotationAndATranslation)
+{
+  // toSensorFrame() inverts the rotation by its transpose: a scaled or mirrored pose
+  // would map the points wrongly. triangulate() and insertPoints() refuse it, and a
+  // cloud orientation that is no quaternion (a zero one is read as the identity).
+  const Cloud::Ptr cloud = angleGrid(5, 4, 0.01, 0.01);
+  SphericalDelaunay<pcl::PointXYZ> delaunay;
+  delaunay.setAngleQuantization(1e-4);
+  delaunay.setInputCloud(cloud);
+  ASSERT_TRUE(delaunay.sensorPoseIsRigid());
+  ASSERT_TRUE(delaunay.triangulate());
+  std::vector<Triangle> neighbours;
+  delaunay.takeNeighbours(neighbours);
+  Cloud::Ptr more(new Cloud(*cloud));
+  more->push_back(pcl::PointXYZ(0.015f, 0.015f, 1.f));
+  delaunay.setInputCloud(more);
+  Eigen::Affine3f scaled = Eigen::Affine3f::Identity();
+  scaled.scale(1.5f);
+  delaunay.setSensorPose(scaled);
+  std::string why;
+  EXPECT_FALSE(delaunay.sensorPoseIsRigid(&why));
+  EXPECT_NE(why.find("setSensorPose"), std::string::npos) << why;
+  DelaunayInsertion info;
+  std::vector<pcl::index_t> moved;
+  EXPECT_FALSE(delaunay.insertPoints(cloud->size(), neighbours, info, moved));
+  delaunay.resetSensorPose();
+  EXPECT_TRUE(delaunay.insertPoints(cloud->size(), neighbours, info, moved));
+  delaunay.setSensorPose(scaled);
+  EXPECT_FALSE(delaunay.triangulate());
+  delaunay.resetSensorPose();
+
+  Cloud::Ptr zero(new Cloud(*cloud));
+  zero->sensor_orientation_ = Eigen::Quaternionf(0.f, 0.f, 0.f, 0.f);
+  delaunay.setInputCloud(zero);
+  EXPECT_FALSE(delaunay.sensorPoseIsRigid(&why));
+  EXPECT_NE(why.find("sensor_orientation_"), std::string::npos) << why;
+  EXPECT_FALSE(delaunay.triangulate());
 }
 
 TEST(SphericalDelaunay, ReconstructGrid)

@@ -557,9 +557,10 @@ insertDelaunayPoints(std::vector<QuantizedPoint>& points,
                      unsigned int num_threads)
 {
   info = DelaunayInsertion();
+  // Compared without std::abs, whose value at INT_MIN is undefined.
   const auto inRange = [](const QuantizedPoint& p) {
-    return std::abs(p[0]) <= kMaxDelaunayCoordinate &&
-           std::abs(p[1]) <= kMaxDelaunayCoordinate;
+    return p[0] >= -kMaxDelaunayCoordinate && p[0] <= kMaxDelaunayCoordinate &&
+           p[1] >= -kMaxDelaunayCoordinate && p[1] <= kMaxDelaunayCoordinate;
   };
   if (triangles.empty() || neighbours.size() != triangles.size()) {
     detail::setError(error,
@@ -572,6 +573,10 @@ insertDelaunayPoints(std::vector<QuantizedPoint>& points,
                        "insertDelaunayPoints: the old points are not sorted and distinct");
       return false;
     }
+  if (!std::all_of(points.begin(), points.end(), inRange)) {
+    detail::setError(error, "insertDelaunayPoints: an old point is out of range");
+    return false;
+  }
   std::sort(new_points.begin(), new_points.end());
   for (std::size_t i = 0; i < new_points.size(); ++i) {
     if (!inRange(new_points[i]) || (i > 0 && new_points[i - 1] == new_points[i]) ||

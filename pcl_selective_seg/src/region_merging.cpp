@@ -7,12 +7,14 @@
 #include <pcl_selective_seg/region_merging.h>
 #include <pcl_selective_seg/spherical_delaunay.h>
 
-#include "incidence_build.h"
+#include <pcl/console/print.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <numeric>
+
+#include "incidence_build.h"
 
 namespace pcl {
 namespace selective_seg {
@@ -640,6 +642,23 @@ mergeSeedSegments(const MergeInput& input,
                   std::vector<pcl::index_t>& leaf_segment,
                   Vector3fVector& segment_normals)
 {
+  const char* missing = nullptr;
+  if (!input.vertex_leaf || !input.triangles || !input.triangle_normals)
+    missing = "vertex_leaf, triangles and triangle_normals are required";
+  else if (!input.leaves && (!input.leaf_normals || !input.leaf_areas))
+    missing = "leaves, or leaf_normals and leaf_areas, are required";
+  else if (!input.leaves && input.leaf_normals->size() != input.leaf_areas->size())
+    missing = "leaf_normals and leaf_areas differ in size";
+  else if (input.triangle_normals->size() != input.triangles->size() ||
+           (input.triangle_edge_on &&
+            input.triangle_edge_on->size() != input.triangles->size()))
+    missing = "triangle_normals (and triangle_edge_on) need one entry per triangle";
+  if (missing) {
+    PCL_ERROR("[pcl::selective_seg::mergeSeedSegments] %s\n", missing);
+    leaf_segment.clear();
+    segment_normals.clear();
+    return;
+  }
   SeedMerger merger(input);
   merger.run(leaf_segment, segment_normals);
   if (input.replay)

@@ -20,6 +20,13 @@ namespace selective_seg {
 /** \brief 3-vectors (Eigen::Vector3f needs no aligned allocator). */
 using Vector3fVector = std::vector<Eigen::Vector3f>;
 
+// Preconditions of every function below, not checked (each would cost a pass over the
+// mesh on the pipeline's path, whose arrays meet them): a triangle's vertex ids are
+// below the number of vertices the function is given (num_vertices, or the size of its
+// per-vertex arrays); per-triangle inputs have one entry per triangle; triangle ids
+// (changed triangles, old_to_new) are below the number of triangles or -1 where
+// documented. Broken inputs read or write out of bounds.
+
 /** \brief Unit normal and 3-D area of each triangle (paper, Sec. III.B).
  *
  * \param[in] positions \#V vertex positions [m]

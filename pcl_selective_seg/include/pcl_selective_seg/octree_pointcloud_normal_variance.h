@@ -102,8 +102,9 @@ public:
   explicit OctreePointCloudNormalVariance(double resolution);
 
   /** \brief Per-point normals and point areas A_p (eq. 3), indexed like the input
-   * cloud. Points whose normal is not finite or whose area is not positive are skipped
-   * by addPointsFromInputCloud(). */
+   * cloud. Points whose normal is not finite or is zero, or whose area is not
+   * positive (or so small that eq. 4's weight 1 / A_p overflows), are skipped by
+   * addPointsFromInputCloud(). */
   void setInputNormals(const NormalCloudConstPtr& normals, const AreasConstPtr& areas);
 
   /** \brief The same with the normals as plain 3-vectors (12 bytes per point instead of
@@ -137,13 +138,17 @@ public:
   /** \brief Fit the bounding box to the valid points and insert them. Replaces
    * OctreePointCloud::addPointsFromInputCloud (which ignores normals and grows the
    * box in insertion order); into a tree that already holds points they are inserted
-   * as PCL's octree does, its box kept or grown. \return false, with a PCL_ERROR when
-   * the points need more than kMaxDepth levels of the resolution, when no point is
-   * valid. */
+   * as PCL's octree does, its box kept or grown. A point is valid when it is finite,
+   * its normal finite and not zero, and its area positive with a finite inverse (eq.
+   * 4's weight). \return false, with a PCL_ERROR when the resolution is not positive
+   * and finite or the points need more than kMaxDepth levels of it; false when no
+   * point is valid. */
   bool addPointsFromInputCloud();
 
   /** \brief Split from the root while sigma_theta or sigma_phi > max_std_dev [rad]
-   * and the node holds at least min_points_to_split points (eq. 4-5). */
+   * and the node holds at least min_points_to_split points (eq. 4-5). No leaves, with
+   * a PCL_ERROR, when the tree holds a point without a finite, non-zero normal and a
+   * positive area (one added by OctreePointCloud's own insertion methods). */
   void computeAdaptiveLeaves(double max_std_dev, std::size_t min_points_to_split);
 
   /** \brief addPointsFromInputCloud() then computeAdaptiveLeaves(): the same tree and
@@ -154,6 +159,21 @@ public:
 
   /** \brief The leaves, in depth-first (Morton) order. */
   const std::vector<AdaptiveLeaf>& getAdaptiveLeaves() const { return leaves_; }
+
+  /** \brief OctreePointCloud::deleteTree(), and the adaptive leaves and ordered
+   * indices with it. (Called through a reference to the base class, PCL's alone runs:
+   * the leaves then stay until the next computeAdaptiveLeaves().) */
+  void deleteTree()
+  {
+    OctreeT::deleteTree();
+    leaves_.clear();
+    ordered_indices_ = pcl::Indices();
+    voxel_indices_ = pcl::Indices();
+    leaves_view_ordered_ = false;
+    angles_ready_ = false;
+    num_kept_leaves_ = 0;
+    releaseScratch();
+  }
 
   /** \brief What a tree's leaves depend on besides its points: the box, finest
    * voxel and depth, the thresholds, the frame of eq. 5's angles and the sensor

@@ -96,7 +96,10 @@ struct MergeInput {
  * grows again in turn): the result is the one-thread result, bit for bit
  * (docs/performance.md, "Round 6").
  *
- * \param[in] input the seeds and the mesh
+ * \param[in] input the seeds and the mesh. A missing array, or arrays whose sizes
+ *            disagree, give a PCL_ERROR and empty outputs. Not checked (a pass over
+ *            the mesh, on the pipeline's path): every triangle's vertex ids are below
+ *            \#V (vertex_leaf's size) and every vertex_leaf entry below \#L or -1.
  * \param[out] leaf_segment \#L segment id of each seed, 0..#S-1 in creation order
  * \param[out] segment_normals \#S unit segment normals N_S (eq. 7)
  */

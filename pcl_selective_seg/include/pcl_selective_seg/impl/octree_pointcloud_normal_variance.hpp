@@ -102,8 +102,11 @@ OctreePointCloudNormalVariance<PointT>::isValidPoint(pcl::index_t index) const
   if (i >= this->input_->size() || i >= numInputNormals() || i >= areas_->size())
     return false;
   const double area = (*areas_)[i];
-  return pcl::isFinite((*this->input_)[i]) && inputNormal(i).allFinite() &&
-         std::isfinite(area) && area > 0.0;
+  const Eigen::Vector3f normal = inputNormal(i);
+  // Eq. 4 weighs a point by 1 / A_p: a subnormal area would weigh infinitely.
+  return pcl::isFinite((*this->input_)[i]) && normal.allFinite() &&
+         normal.squaredNorm() > 0.0f && std::isfinite(area) && area > 0.0 &&
+         std::isfinite(1.0 / area);
 }
 
 template <typename PointT>
@@ -146,6 +149,12 @@ OctreePointCloudNormalVariance<PointT>::insertPoints(bool with_angles)
   angles_ready_ = false;
   if (!this->input_ || (!normals_ && !normal_vectors_) || !areas_)
     return false;
+  if (!(this->resolution_ > 0.0) || !std::isfinite(this->resolution_)) {
+    PCL_ERROR("[pcl::selective_seg::OctreePointCloudNormalVariance] the resolution "
+              "(smallest voxel) is %g: it must be positive and finite\n",
+              this->resolution_);
+    return false;
+  }
   // Which points are valid, and their box, in parallel (a flag per candidate, then one
   // compaction in increasing order; min and max do not depend on the order).
   const auto num_candidates = static_cast<std::ptrdiff_t>(
@@ -564,6 +573,23 @@ OctreePointCloudNormalVariance<PointT>::computeAdaptiveLeaves(
     voxel_codes_.reserve(this->leaf_count_);
     voxel_first_.reserve(this->leaf_count_);
     orderPoints(this->root_node_, pcl::octree::OctreeKey());
+    // OctreePointCloud's own insertion methods (addPointToCloud(), its
+    // addPointsFromInputCloud() through a base reference) are not virtual and check
+    // nothing: a point they added may have no normal or area.
+    const bool all_valid =
+        (normals_ || normal_vectors_) && areas_ &&
+        std::all_of(ordered_indices_.begin(),
+                    ordered_indices_.end(),
+                    [this](pcl::index_t i) { return isValidPoint(i); });
+    if (!all_valid) {
+      PCL_ERROR("[pcl::selective_seg::OctreePointCloudNormalVariance] the tree holds a "
+                "point without a finite normal and a positive area: add the points "
+                "with this class's addPointsFromInputCloud(), not OctreePointCloud's "
+                "insertion methods\n");
+      ordered_indices_ = pcl::Indices();
+      releaseScratch();
+      return;
+    }
     computeNormalAngles();
   }
   const std::size_t min_points = std::max<std::size_t>(min_points_to_split, 2);

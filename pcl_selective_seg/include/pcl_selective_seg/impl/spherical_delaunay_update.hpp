@@ -25,10 +25,11 @@ SphericalDelaunay<PointT>::insertPoints(std::size_t first_new_point,
 {
   moved_vertices.clear();
   SphericalTriangulation& tri = triangulation_;
-  if (!this->input_ || tri.triangles.empty() || neighbours.size() != tri.triangles.size() ||
+  if (!this->input_ || tri.triangles.empty() ||
+      neighbours.size() != tri.triangles.size() ||
       tri.point_vertex.size() != first_new_point ||
       first_new_point > this->input_->size() ||
-      tri.angle_quantization != angle_quantization_)
+      tri.angle_quantization != angle_quantization_ || !sensorPoseIsRigid())
     return false;
   if (!this->initCompute())
     return false;
