@@ -637,13 +637,18 @@ TEST(OctreePointCloudNormalVariance, ResolutionMustBePositiveAndFinite)
                                   std::numeric_limits<double>::infinity(),
                                   std::numeric_limits<double>::quiet_NaN()}) {
     SCOPED_TRACE(resolution);
-    Octree octree(0.05);
-    octree.setResolution(resolution);
+    // Given to the constructor: the insertion refuses it (-1 and inf gave one leaf).
+    Octree octree(resolution);
     octree.setInputCloud(scene.cloud);
     octree.setInputNormals(scene.normals, scene.areas);
     EXPECT_FALSE(octree.addPointsFromInputCloud());
     octree.computeAdaptiveLeaves(kPaperThreshold, kMinPoints);
     EXPECT_TRUE(octree.getAdaptiveLeaves().empty());
+    // Given to setResolution(): refused, the resolution kept (PCL's own converts it to
+    // voxel counts out of range: undefined behaviour).
+    Octree kept(0.05);
+    kept.setResolution(resolution);
+    EXPECT_EQ(kept.getResolution(), 0.05);
   }
 }
 

@@ -11,10 +11,12 @@
 #include <pcl_selective_seg/parameters.h>
 
 #include <Eigen/Geometry>
+#include <pcl/console/print.h>
 #include <pcl/octree/octree_pointcloud.h>
 #include <pcl/point_types.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -159,6 +161,20 @@ public:
 
   /** \brief The leaves, in depth-first (Morton) order. */
   const std::vector<AdaptiveLeaf>& getAdaptiveLeaves() const { return leaves_; }
+
+  /** \brief OctreePointCloud::setResolution() for a positive, finite \a resolution
+   * [m]; any other is refused with a PCL_ERROR and the resolution kept (PCL's own
+   * converts it to voxel counts out of range). */
+  void setResolution(double resolution)
+  {
+    if (!(resolution > 0.0) || !std::isfinite(resolution)) {
+      PCL_ERROR("[pcl::selective_seg::OctreePointCloudNormalVariance] resolution %g "
+                "refused: it must be positive and finite\n",
+                resolution);
+      return;
+    }
+    OctreeT::setResolution(resolution);
+  }
 
   /** \brief OctreePointCloud::deleteTree(), and the adaptive leaves and ordered
    * indices with it. (Called through a reference to the base class, PCL's alone runs:
