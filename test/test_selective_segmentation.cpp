@@ -13,6 +13,7 @@
 #include <boost/preprocessor/seq/enum.hpp>
 #include <gtest/gtest.h>
 #include <pcl/common/transforms.h>
+#include <pcl/conversions.h>
 
 #include <algorithm>
 #include <limits>
@@ -821,6 +822,17 @@ TEST(SelectiveSegmentation, CloudWhoseLayoutIsNotItsSize)
   EXPECT_EQ(normals->size(), cloud->size());
   EXPECT_EQ(normals->height, 1u);
   EXPECT_TRUE((*normals)[cloud->size() - 1].getNormalVector3fMap().allFinite());
+  // The mesh's cloud blob too: rows that describe exactly the bytes it holds.
+  pcl::PolygonMesh mesh;
+  seg.getPolygonMesh(mesh);
+  EXPECT_EQ(static_cast<std::size_t>(mesh.cloud.width) * mesh.cloud.height,
+            cloud->size());
+  EXPECT_EQ(static_cast<std::size_t>(mesh.cloud.row_step) * mesh.cloud.height,
+            mesh.cloud.data.size());
+  pcl::PointCloud<pcl::PointXYZ> back;
+  pcl::fromPCLPointCloud2(mesh.cloud, back);
+  ASSERT_EQ(back.size(), cloud->size());
+  EXPECT_EQ(back.back().getVector3fMap(), cloud->back().getVector3fMap());
 }
 
 TEST(SelectiveSegmentation, SensorPoseMustBeARotationAndATranslation)

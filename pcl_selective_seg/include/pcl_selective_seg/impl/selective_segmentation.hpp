@@ -769,6 +769,14 @@ SelectiveSegmentation<PointT>::getPolygonMesh(pcl::PolygonMesh& mesh) const
       result_.labels.size() != mesh_input_->size())
     return;
   pcl::toPCLPointCloud2(*mesh_input_, mesh.cloud);
+  // A declared layout that is not the cloud's size would make a blob whose rows
+  // describe more or fewer bytes than it holds: one row then, as the other getters.
+  if (static_cast<std::size_t>(mesh_input_->width) * mesh_input_->height !=
+      mesh_input_->size()) {
+    mesh.cloud.width = static_cast<std::uint32_t>(mesh_input_->size());
+    mesh.cloud.height = 1;
+    mesh.cloud.row_step = mesh.cloud.point_step * mesh.cloud.width;
+  }
   mesh.header = mesh_input_->header;
   mesh.polygons.resize(result_.mesh.triangles.size());
   for (std::size_t t = 0; t < mesh.polygons.size(); ++t) {
