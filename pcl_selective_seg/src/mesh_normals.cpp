@@ -298,6 +298,38 @@ starOf(pcl::index_t v,
        const std::vector<Triangle>& neighbours,
        std::vector<pcl::index_t>& star);
 
+/** Eq. 2-3 at each of the distinct \a vertices over all its triangles, found by one
+ * pass over the mesh and each listed once per corner at the vertex, in increasing order
+ * (as the gather of computeVertexNormals() sums them): \a out_normals[k] and \a
+ * out_areas[k] are those of vertices[k]. */
+void
+vertexNormalsOverTheMesh(const std::vector<pcl::index_t>& vertices,
+                         std::size_t num_vertices,
+                         const std::vector<Triangle>& triangles,
+                         const Vector3fVector& normals,
+                         const std::vector<double>& areas,
+                         Vector3fVector& out_normals,
+                         std::vector<double>& out_areas)
+{
+  std::vector<pcl::index_t> slot(num_vertices, -1);
+  for (std::size_t k = 0; k < vertices.size(); ++k)
+    slot[vertices[k]] = static_cast<pcl::index_t>(k);
+  std::vector<std::vector<pcl::index_t>> lists(vertices.size());
+  for (std::size_t t = 0; t < triangles.size(); ++t)
+    for (const auto v : triangles[t])
+      if (slot[v] >= 0)
+        lists[slot[v]].push_back(static_cast<pcl::index_t>(t));
+  out_normals.resize(vertices.size());
+  out_areas.resize(vertices.size());
+  for (std::size_t k = 0; k < vertices.size(); ++k)
+    vertexNormal(lists[k].data(),
+                 lists[k].data() + lists[k].size(),
+                 normals,
+                 areas,
+                 out_normals[k],
+                 out_areas[k]);
+}
+
 /** Eq. 2-3 again at each vertex of \a seeds ((vertex, one of its triangles) pairs, a
  * vertex possibly listed several times), summed over its star in increasing order as
  * computeVertexNormals() sums it. With \a incidence (the number of triangle corners at
@@ -350,30 +382,19 @@ recomputeOverStars(std::vector<std::pair<pcl::index_t, pcl::index_t>>& seeds,
   }
   if (std::find(partial.begin(), partial.end(), 1) == partial.end())
     return;
-  // The vertices the walk did not get around: their triangles, each listed once per
-  // corner at the vertex, in increasing order, from one pass over the mesh.
-  std::vector<pcl::index_t> slot(vertex_normals.size(), -1);
-  std::vector<std::vector<pcl::index_t>> lists;
+  // The vertices the walk did not get around, over their triangles from the mesh.
+  std::vector<pcl::index_t> unwalked;
   for (std::size_t k = 0; k < seeds.size(); ++k)
-    if (partial[k]) {
-      slot[seeds[k].first] = static_cast<pcl::index_t>(lists.size());
-      lists.emplace_back();
-    }
-  for (std::size_t t = 0; t < triangles.size(); ++t)
-    for (const auto v : triangles[t])
-      if (slot[v] >= 0)
-        lists[slot[v]].push_back(static_cast<pcl::index_t>(t));
-  for (std::size_t k = 0; k < seeds.size(); ++k)
-    if (partial[k]) {
-      const pcl::index_t v = seeds[k].first;
-      const auto& list = lists[slot[v]];
-      vertexNormal(list.data(),
-                   list.data() + list.size(),
-                   normals,
-                   areas,
-                   vertex_normals[v],
-                   vertex_areas[v]);
-    }
+    if (partial[k])
+      unwalked.push_back(seeds[k].first);
+  Vector3fVector sums;
+  std::vector<double> sum_areas;
+  vertexNormalsOverTheMesh(
+      unwalked, vertex_normals.size(), triangles, normals, areas, sums, sum_areas);
+  for (std::size_t k = 0; k < unwalked.size(); ++k) {
+    vertex_normals[unwalked[k]] = sums[k];
+    vertex_areas[unwalked[k]] = sum_areas[k];
+  }
 }
 
 /** computeVertexNormals() by adding each triangle's terms (eq. 2-3) to its vertices, in
@@ -723,28 +744,13 @@ fillMissingVertexNormals(const std::vector<Triangle>& triangles,
       give(v, ring_normals.at(v, list));
     return filled;
   }
-  // One ring: the missing vertices' triangles, each listed once per corner at the
-  // vertex, in increasing order (as the gather of computeVertexNormals() sums them),
-  // from one pass over the mesh.
-  std::vector<pcl::index_t> slot(num_vertices, -1);
+  // One ring: the missing vertices' own triangles, from one pass over the mesh.
+  Vector3fVector sums;
+  std::vector<double> sum_areas;
+  vertexNormalsOverTheMesh(
+      missing, num_vertices, triangles, normals, areas, sums, sum_areas);
   for (std::size_t k = 0; k < missing.size(); ++k)
-    slot[missing[k]] = static_cast<pcl::index_t>(k);
-  std::vector<std::vector<pcl::index_t>> lists(missing.size());
-  for (std::size_t t = 0; t < triangles.size(); ++t)
-    for (const auto v : triangles[t])
-      if (slot[v] >= 0)
-        lists[slot[v]].push_back(static_cast<pcl::index_t>(t));
-  for (std::size_t k = 0; k < missing.size(); ++k) {
-    Eigen::Vector3f normal;
-    double area;
-    vertexNormal(lists[k].data(),
-                 lists[k].data() + lists[k].size(),
-                 normals,
-                 areas,
-                 normal,
-                 area);
-    give(missing[k], normal);
-  }
+    give(missing[k], sums[k]);
   return filled;
 }
 
