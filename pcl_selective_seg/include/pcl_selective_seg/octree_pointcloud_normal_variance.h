@@ -317,6 +317,9 @@ protected:
   LeafSettings leafSettings(double max_std_dev, std::size_t min_points_to_split) const;
 
 private:
+  /** Whether normals (in either form) and areas were given. */
+  bool hasNormalsAndAreas() const { return (normals_ || normal_vectors_) && areas_; }
+
   /** The input normal of point \a i, from whichever form was given. */
   Eigen::Vector3f inputNormal(std::size_t i) const
   {

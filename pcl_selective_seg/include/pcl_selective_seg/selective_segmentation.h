@@ -326,8 +326,18 @@ protected:
 
   /** \brief The triangle normals eq. 2 sums: triangle_normals_, or with
    * PointNormalTriangles::NotEdgeOn a copy in \a masked without the edge-on ones
-   * (maskEdgeOnNormals(); follow with fillMissingVertexNormals()). */
+   * (maskEdgeOnNormals(); follow with fillEdgeOnOnlyVertices()). */
   const Vector3fVector& eq2TriangleNormals(Vector3fVector& masked) const;
+
+  /** \brief With PointNormalTriangles::NotEdgeOn, the vertices whose triangles are all
+   * edge-on (no normal from eq2TriangleNormals()) get eq. 2 over all of them
+   * (fillMissingVertexNormals()); otherwise nothing. */
+  void fillEdgeOnOnlyVertices(Vector3fVector& vertex_normals) const;
+
+  /** \brief Whether the last run's cloud declares a layout (width x height) that is
+   * its size; a cloud whose points were pushed after it was loaded may not. The
+   * getters give such a cloud's outputs one row. */
+  bool runLayoutIsItsSize() const;
 
   /** \brief An output cloud of the last run's size, layout and header, every point
    * \a fill. */

@@ -147,7 +147,7 @@ bool
 OctreePointCloudNormalVariance<PointT>::insertPoints(bool with_angles)
 {
   angles_ready_ = false;
-  if (!this->input_ || (!normals_ && !normal_vectors_) || !areas_)
+  if (!this->input_ || !hasNormalsAndAreas())
     return false;
   if (!(this->resolution_ > 0.0) || !std::isfinite(this->resolution_)) {
     PCL_ERROR("[pcl::selective_seg::OctreePointCloudNormalVariance] the resolution "
@@ -576,11 +576,11 @@ OctreePointCloudNormalVariance<PointT>::computeAdaptiveLeaves(
     // OctreePointCloud's own insertion methods (addPointToCloud(), its
     // addPointsFromInputCloud() through a base reference) are not virtual and check
     // nothing: a point they added may have no normal or area.
-    const bool all_valid =
-        (normals_ || normal_vectors_) && areas_ &&
-        std::all_of(ordered_indices_.begin(),
-                    ordered_indices_.end(),
-                    [this](pcl::index_t i) { return isValidPoint(i); });
+    const bool all_valid = hasNormalsAndAreas() && std::all_of(ordered_indices_.begin(),
+                                                               ordered_indices_.end(),
+                                                               [this](pcl::index_t i) {
+                                                                 return isValidPoint(i);
+                                                               });
     if (!all_valid) {
       PCL_ERROR("[pcl::selective_seg::OctreePointCloudNormalVariance] the tree holds a "
                 "point without a finite normal and a positive area: add the points "

@@ -187,13 +187,7 @@ SelectiveSegmentation<PointT>::computeNormals()
                                   triangle_areas_,
                                   params_.normal_rings,
                                   vertex_normals_);
-  if (&eq2_normals == &masked)
-    fillMissingVertexNormals(tri.triangles,
-                             triangle_normals_,
-                             triangle_areas_,
-                             params_.normal_rings,
-                             vertex_normals_,
-                             params_.num_threads);
+  fillEdgeOnOnlyVertices(vertex_normals_);
   return publishNormals();
 }
 
@@ -205,6 +199,20 @@ SelectiveSegmentation<PointT>::eq2TriangleNormals(Vector3fVector& masked) const
     return triangle_normals_;
   maskEdgeOnNormals(triangle_normals_, triangle_edge_on_, masked, params_.num_threads);
   return masked;
+}
+
+template <typename PointT>
+void
+SelectiveSegmentation<PointT>::fillEdgeOnOnlyVertices(
+    Vector3fVector& vertex_normals) const
+{
+  if (params_.point_normal_triangles == PointNormalTriangles::NotEdgeOn)
+    fillMissingVertexNormals(delaunay_.getTriangulation().triangles,
+                             triangle_normals_,
+                             triangle_areas_,
+                             params_.normal_rings,
+                             vertex_normals,
+                             params_.num_threads);
 }
 
 template <typename PointT>
@@ -697,6 +705,14 @@ SelectiveSegmentation<PointT>::segmentMesh(std::vector<pcl::PointIndices>& clust
 }
 
 template <typename PointT>
+bool
+SelectiveSegmentation<PointT>::runLayoutIsItsSize() const
+{
+  const PointCloud& run = *mesh_input_;
+  return static_cast<std::size_t>(run.width) * run.height == run.size();
+}
+
+template <typename PointT>
 template <typename CloudT>
 pcl::shared_ptr<CloudT>
 SelectiveSegmentation<PointT>::cloudShapedLikeTheRun(
@@ -704,9 +720,7 @@ SelectiveSegmentation<PointT>::cloudShapedLikeTheRun(
 {
   const PointCloud& run = *mesh_input_;
   auto out = pcl::make_shared<CloudT>();
-  // The run's layout when it is one (width x height = size: a cloud whose points were
-  // pushed after it was loaded may not be), else one row.
-  if (static_cast<std::size_t>(run.width) * run.height == run.size())
+  if (runLayoutIsItsSize())
     *out = CloudT(run.width, run.height, fill);
   else
     out->resize(run.size(), fill);
@@ -771,8 +785,7 @@ SelectiveSegmentation<PointT>::getPolygonMesh(pcl::PolygonMesh& mesh) const
   pcl::toPCLPointCloud2(*mesh_input_, mesh.cloud);
   // A declared layout that is not the cloud's size would make a blob whose rows
   // describe more or fewer bytes than it holds: one row then, as the other getters.
-  if (static_cast<std::size_t>(mesh_input_->width) * mesh_input_->height !=
-      mesh_input_->size()) {
+  if (!runLayoutIsItsSize()) {
     mesh.cloud.width = static_cast<std::uint32_t>(mesh_input_->size());
     mesh.cloud.height = 1;
     mesh.cloud.row_step = mesh.cloud.point_step * mesh.cloud.width;

@@ -246,13 +246,7 @@ SelectiveSegmentation<PointT>::updateNormals(const DelaunayInsertion& info,
                                  params_.normal_rings,
                                  changed,
                                  vertex_normals);
-  if (&eq2_normals == &masked)
-    fillMissingVertexNormals(tri.triangles,
-                             triangle_normals_,
-                             triangle_areas_,
-                             params_.normal_rings,
-                             vertex_normals,
-                             params_.num_threads);
+  fillEdgeOnOnlyVertices(vertex_normals);
   // The vertices of the changed triangles; their voxels changed for the octree (the new
   // vertices are corners of new triangles).
   const bool note_changes = !previous_leaves_.leaves.empty();
