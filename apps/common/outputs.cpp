@@ -27,6 +27,7 @@
 #include <type_traits>
 
 #include "segment_colors.h"
+#include "segmentation_options.h"
 #include <unistd.h>
 
 namespace selseg_apps {
@@ -56,11 +57,7 @@ POINT_CLOUD_REGISTER_POINT_STRUCT(
 namespace selseg_apps {
 namespace {
 
-using pcl::selective_seg::EdgeTriangleNormal;
-using pcl::selective_seg::NormalSpreadFrame;
-using pcl::selective_seg::PointNormalTriangles;
 using pcl::selective_seg::SegmentedMesh;
-using pcl::selective_seg::SegmentNormalWeight;
 
 /** The vertices the triangles use, numbered densely in the order of their first use. */
 struct CompactMesh {
@@ -668,19 +665,11 @@ writeSummaryJson(const std::string& path,
       << ", \"merge_deg\": " << p.max_merge_angle * deg
       << ", \"edge_deg\": " << p.max_edge_triangle_angle * deg
       << ", \"incidence_deg\": " << p.max_view_incidence_angle * deg
-      << ", \"spread_frame\": "
-      << (p.normal_spread_frame == NormalSpreadFrame::MeanNormal ? "\"mean_normal\""
-                                                                 : "\"sensor\"")
-      << ", \"segment_weight\": "
-      << (p.segment_normal_weight == SegmentNormalWeight::Area ? "\"area\""
-                                                               : "\"inverse_area\"")
-      << ", \"normal_rings\": " << p.normal_rings << ", \"normal_triangles\": "
-      << (p.point_normal_triangles == PointNormalTriangles::NotEdgeOn
-              ? "\"not_edge_on\""
-              : "\"all\"")
-      << ", \"edge_normal\": "
-      << (p.edge_triangle_normal == EdgeTriangleNormal::VertexMean ? "\"vertex_mean\""
-                                                                   : "\"facet\"")
+      << ", \"spread_frame\": " << jsonString(choiceName(p.normal_spread_frame))
+      << ", \"segment_weight\": " << jsonString(choiceName(p.segment_normal_weight))
+      << ", \"normal_rings\": " << p.normal_rings
+      << ", \"normal_triangles\": " << jsonString(choiceName(p.point_normal_triangles))
+      << ", \"edge_normal\": " << jsonString(choiceName(p.edge_triangle_normal))
       << ", \"min_voxel_m\": " << r.min_voxel_size
       << ", \"voxel_factor\": " << p.min_voxel_size_factor
       << ", \"min_split_points\": " << p.min_points_to_split

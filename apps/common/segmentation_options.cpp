@@ -33,14 +33,38 @@ parseDegrees(int argc, char** argv, const char* flag, double& radians)
   return true;
 }
 
+template <typename Enum> using Choices = std::vector<std::pair<std::string, Enum>>;
+
+// The command-line names of the enum options' values, read by the parser and written
+// by choiceName() (the JSON summary).
+const Choices<SegmentNormalWeight> kSegmentWeights = {
+    {"inverse_area", SegmentNormalWeight::InverseArea},
+    {"area", SegmentNormalWeight::Area}};
+const Choices<NormalSpreadFrame> kSpreadFrames = {
+    {"sensor", NormalSpreadFrame::Sensor},
+    {"mean_normal", NormalSpreadFrame::MeanNormal}};
+const Choices<PointNormalTriangles> kNormalTriangles = {
+    {"all", PointNormalTriangles::All},
+    {"not_edge_on", PointNormalTriangles::NotEdgeOn}};
+const Choices<EdgeTriangleNormal> kEdgeNormals = {
+    {"facet", EdgeTriangleNormal::Facet},
+    {"vertex_mean", EdgeTriangleNormal::VertexMean}};
+
+template <typename Enum>
+std::string
+nameIn(const Choices<Enum>& choices, Enum value)
+{
+  for (const auto& c : choices)
+    if (c.second == value)
+      return c.first;
+  return std::to_string(static_cast<int>(value));
+}
+
 /** A named choice: absent keeps \a value; an unknown name is an error. */
 template <typename Enum>
 bool
-parseChoice(int argc,
-            char** argv,
-            const char* flag,
-            const std::vector<std::pair<std::string, Enum>>& choices,
-            Enum& value)
+parseChoice(
+    int argc, char** argv, const char* flag, const Choices<Enum>& choices, Enum& value)
 {
   std::string name;
   if (pcl::console::parse_argument(argc, argv, flag, name) < 0)
@@ -55,6 +79,30 @@ parseChoice(int argc,
 }
 
 } // namespace
+
+std::string
+choiceName(SegmentNormalWeight value)
+{
+  return nameIn(kSegmentWeights, value);
+}
+
+std::string
+choiceName(NormalSpreadFrame value)
+{
+  return nameIn(kSpreadFrames, value);
+}
+
+std::string
+choiceName(PointNormalTriangles value)
+{
+  return nameIn(kNormalTriangles, value);
+}
+
+std::string
+choiceName(EdgeTriangleNormal value)
+{
+  return nameIn(kEdgeNormals, value);
+}
 
 bool
 optionsGivenOnce(int argc,
@@ -165,30 +213,15 @@ parseSegmentationOptions(int argc, char** argv, SelectiveSegmentationParameters&
       !parseNumber(argc, argv, "-max_depth", p.max_octree_depth) ||
       !parseNumber(argc, argv, "-angle_step_rad", p.angle_quantization) ||
       !parseNumber(argc, argv, "-threads", p.num_threads) ||
-      !parseChoice(argc,
-                   argv,
-                   "-segment_weight",
-                   {{"inverse_area", SegmentNormalWeight::InverseArea},
-                    {"area", SegmentNormalWeight::Area}},
-                   p.segment_normal_weight) ||
-      !parseChoice(argc,
-                   argv,
-                   "-spread_frame",
-                   {{"sensor", NormalSpreadFrame::Sensor},
-                    {"mean_normal", NormalSpreadFrame::MeanNormal}},
-                   p.normal_spread_frame) ||
+      !parseChoice(
+          argc, argv, "-segment_weight", kSegmentWeights, p.segment_normal_weight) ||
+      !parseChoice(argc, argv, "-spread_frame", kSpreadFrames, p.normal_spread_frame) ||
       !parseChoice(argc,
                    argv,
                    "-normal_triangles",
-                   {{"all", PointNormalTriangles::All},
-                    {"not_edge_on", PointNormalTriangles::NotEdgeOn}},
+                   kNormalTriangles,
                    p.point_normal_triangles) ||
-      !parseChoice(argc,
-                   argv,
-                   "-edge_normal",
-                   {{"facet", EdgeTriangleNormal::Facet},
-                    {"vertex_mean", EdgeTriangleNormal::VertexMean}},
-                   p.edge_triangle_normal) ||
+      !parseChoice(argc, argv, "-edge_normal", kEdgeNormals, p.edge_triangle_normal) ||
       !parseChoice(argc,
                    argv,
                    "-backend",

@@ -52,6 +52,13 @@ const std::vector<std::string>& segmentationFlags();
 /** \brief Print the help lines of those flags, with units and defaults. */
 void printSegmentationHelp();
 
+/** \brief The command-line name of an enum option's value (as -segment_weight,
+ * -spread_frame, -normal_triangles and -edge_normal take it). */
+std::string choiceName(pcl::selective_seg::SegmentNormalWeight value);
+std::string choiceName(pcl::selective_seg::NormalSpreadFrame value);
+std::string choiceName(pcl::selective_seg::PointNormalTriangles value);
+std::string choiceName(pcl::selective_seg::EdgeTriangleNormal value);
+
 /** \brief Read those flags into \a params (degrees on the command line, radians in the
  * struct) and validate the result.
  * \return false, after printing what is wrong, on a bad value */
