@@ -40,6 +40,22 @@ cubeScene(std::size_t rays, unsigned seed = 42)
   return selseg_test::cubeScan(rays, seed);
 }
 
+/** \a cloud's points in a random order (one row): shuffled[k] = cloud[perm[k]]. */
+template <typename PointT>
+typename pcl::PointCloud<PointT>::Ptr
+shuffledCopy(const pcl::PointCloud<PointT>& cloud,
+             unsigned seed,
+             std::vector<int>& perm)
+{
+  perm.resize(cloud.size());
+  std::iota(perm.begin(), perm.end(), 0);
+  std::shuffle(perm.begin(), perm.end(), std::mt19937(seed));
+  auto shuffled = pcl::make_shared<pcl::PointCloud<PointT>>();
+  for (const int i : perm)
+    shuffled->push_back(cloud[i]);
+  return shuffled;
+}
+
 template <typename PointT>
 bool
 segment(const typename pcl::PointCloud<PointT>::ConstPtr& cloud,
@@ -131,12 +147,8 @@ TEST(SelectiveSegmentation, EdgeOnTrianglesJoinParallelPlanesWhenNotExcluded)
 TEST(SelectiveSegmentation, ShuffledInputGivesIdenticalSegments)
 {
   const auto cloud = cubeScene(20000, 7);
-  std::vector<int> perm(cloud->size());
-  std::iota(perm.begin(), perm.end(), 0);
-  std::shuffle(perm.begin(), perm.end(), std::mt19937(42));
-  auto shuffled = pcl::make_shared<Labeled>();
-  for (const int i : perm)
-    shuffled->push_back((*cloud)[i]);
+  std::vector<int> perm;
+  const auto shuffled = shuffledCopy(*cloud, 42, perm);
 
   SelectiveSegmentation<pcl::PointXYZL> a, b;
   std::vector<pcl::PointIndices> ca, cb;
@@ -432,15 +444,8 @@ TEST(SelectiveSegmentation, NoisyPixelGridPlaneIsOneSegmentWithoutEdgeOnTriangle
   EXPECT_EQ(beyond_10, 0u);
   EXPECT_GT(paper_beyond_45, cloud->size() / 100);
   // The same segment for the points in another order ...
-  auto shuffled = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>(*cloud);
-  std::vector<int> order(cloud->size());
-  std::iota(order.begin(), order.end(), 0);
-  std::mt19937 rng(2);
-  std::shuffle(order.begin(), order.end(), rng);
-  for (std::size_t i = 0; i < order.size(); ++i)
-    (*shuffled)[i] = (*cloud)[order[i]];
-  shuffled->width = static_cast<std::uint32_t>(shuffled->size());
-  shuffled->height = 1;
+  std::vector<int> order;
+  const auto shuffled = shuffledCopy(*cloud, 2, order);
   SelectiveSegmentation<pcl::PointXYZ> again;
   again.setPointNormalTriangles(pcl::selective_seg::PointNormalTriangles::NotEdgeOn);
   std::vector<pcl::PointIndices> again_clusters;
