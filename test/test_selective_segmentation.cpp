@@ -16,6 +16,7 @@
 #include <pcl/conversions.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <limits>
 #include <map>
 #include <numeric>
@@ -423,7 +424,11 @@ TEST(SelectiveSegmentation, NoisyPixelGridPlaneIsOneSegmentWithoutEdgeOnTriangle
   std::vector<pcl::PointIndices> paper_clusters, clusters;
   ASSERT_TRUE(segment<pcl::PointXYZ>(cloud, paper, paper_clusters));
   ASSERT_TRUE(segment<pcl::PointXYZ>(cloud, seg, clusters));
-  EXPECT_GT(paper_clusters.size(), 20u); // the paper's eq. 2 (measured: 100 or more)
+  std::printf("[ measured ] segments: %zu with the paper's eq. 2, %zu without edge-on "
+              "triangles\n",
+              paper_clusters.size(),
+              clusters.size());
+  EXPECT_GT(paper_clusters.size(), 20u); // the paper's eq. 2 (measured: 189)
   ASSERT_EQ(clusters.size(), 1u);
   EXPECT_EQ(clusters[0].indices.size(), cloud->size());
   // The point normals' angles to the plane's: the noise tilts single facets by a few
