@@ -250,10 +250,17 @@ parseOptions(int argc, char** argv, Options& opt)
       print_error("Option -unit_scale needs a positive number.\n");
     return kUsageError;
   }
-  return selseg_apps::parseSegmentationOptions(argc, argv, opt.params) &&
-                 selseg_apps::parseRegionOptions(argc, argv, opt.roi)
-             ? 0
-             : kUsageError;
+  if (!selseg_apps::parseSegmentationOptions(argc, argv, opt.params) ||
+      !selseg_apps::parseRegionOptions(argc, argv, opt.roi))
+    return kUsageError;
+  if (!opt.roi_json.empty() &&
+      opt.params.projection != pcl::selective_seg::ViewProjection::Forward) {
+    print_error("-roi_json needs the forward projection: regions of interest are "
+                "windows of eq. 1's angles (drop -roi_json or -projection "
+                "panoramic).\n");
+    return kUsageError;
+  }
+  return 0;
 }
 
 /** The sensor pose from the options, or false to keep the file's. */
@@ -307,8 +314,10 @@ printTimings(const pcl::selective_seg::SegmentationResult& r)
 }
 
 void
-printSummary(const pcl::selective_seg::SegmentationResult& r)
+printSummary(const pcl::selective_seg::SegmentationResult& r,
+             pcl::selective_seg::ViewProjection projection)
 {
+  const bool panoramic = projection == pcl::selective_seg::ViewProjection::Panoramic;
   const auto& c = r.counts;
   std::size_t large = 0;
   for (const auto& s : r.segments)
@@ -320,12 +329,17 @@ printSummary(const pcl::selective_seg::SegmentationResult& r)
              r.leaves.size(),
              r.mesh.triangles.size());
   print_info("Points: %zu labeled (%zu sharing a mesh vertex), %zu non-finite, %zu "
-             "behind the sensor, %zu without a normal\n",
+             "%s, %zu without a normal\n",
              c.labeled,
              c.shared_vertex,
              c.non_finite,
              c.behind_sensor,
+             panoramic ? "at the sensor's position" : "behind the sensor",
              c.without_normal);
+  if (!panoramic && c.behind_sensor >= c.labeled / 10 && c.behind_sensor > 0)
+    print_info("%zu points lie behind the sensor and are left unlabeled: for a sensor "
+               "that sees all around (a spinning lidar), use -projection panoramic.\n",
+               c.behind_sensor);
 }
 
 /** Every requested output, all or nothing. */
@@ -439,7 +453,7 @@ segment(const Options& opt)
   // The outputs come from the result: the point lists are freed for the writers.
   std::vector<pcl::PointIndices>().swap(segments);
   printTimings(seg.getResult());
-  printSummary(seg.getResult());
+  printSummary(seg.getResult(), seg.getParameters().projection);
   timer.tic();
   if (!writeOutputs(opt, *cloud, seg, pose))
     return kRuntimeError;

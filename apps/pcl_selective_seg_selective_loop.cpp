@@ -198,6 +198,11 @@ parseOptions(int argc, char** argv, Options& opt)
       !selseg_apps::parseRegionOptions(argc, argv, opt.regions) ||
       !selseg_apps::parseSegmentationOptions(argc, argv, opt.segmentation))
     return false;
+  if (opt.segmentation.projection != pcl::selective_seg::ViewProjection::Forward) {
+    print_error("-projection panoramic does not apply here: the simulated sensor looks "
+                "forward and the regions of interest are windows of eq. 1's angles.\n");
+    return false;
+  }
   if (opt.segmentation.min_voxel_size > 0.0) {
     print_error("-min_voxel_m does not apply here: the loop sets the voxel with "
                 "-min_voxel_factor, the uniform scans choose theirs.\n");

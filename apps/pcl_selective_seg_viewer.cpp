@@ -287,6 +287,11 @@ parseOptions(int argc, char** argv, Options& opt)
     print_error("Give -roi or -roi_json, not both.\n");
     return kUsageError;
   }
+  if (opt.roi && opt.params.projection != pcl::selective_seg::ViewProjection::Forward) {
+    print_error("Regions of interest are windows of the forward projection's angles: "
+                "drop -roi or -projection panoramic.\n");
+    return kUsageError;
+  }
   opt.ignore_viewpoint = find_switch(argc, argv, "-ignore_viewpoint");
   opt.octree_wireframe = find_switch(argc, argv, "-wireframe");
   opt.legend = !find_switch(argc, argv, "-no_legend");

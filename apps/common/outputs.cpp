@@ -675,6 +675,7 @@ writeSummaryJson(const std::string& path,
       << ", \"min_split_points\": " << p.min_points_to_split
       << ", \"max_depth\": " << p.max_octree_depth
       << ", \"angle_step_rad\": " << p.angle_quantization
+      << ", \"projection\": " << jsonString(choiceName(p.projection))
       << ", \"backend\": " << jsonString(info.backend) << "},\n  \"counts\": {"
       << "\"labeled\": " << c.labeled << ", \"shared_vertex\": " << c.shared_vertex
       << ", \"non_finite\": " << c.non_finite

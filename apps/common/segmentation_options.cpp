@@ -20,6 +20,7 @@ using pcl::selective_seg::NormalSpreadFrame;
 using pcl::selective_seg::PointNormalTriangles;
 using pcl::selective_seg::SegmentNormalWeight;
 using pcl::selective_seg::SelectiveSegmentationParameters;
+using pcl::selective_seg::ViewProjection;
 
 constexpr double kDeg = M_PI / 180.0;
 
@@ -46,6 +47,8 @@ const Choices<NormalSpreadFrame> kSpreadFrames = {
 const Choices<PointNormalTriangles> kNormalTriangles = {
     {"all", PointNormalTriangles::All},
     {"not_edge_on", PointNormalTriangles::NotEdgeOn}};
+const Choices<ViewProjection> kProjections = {{"forward", ViewProjection::Forward},
+                                              {"panoramic", ViewProjection::Panoramic}};
 const Choices<EdgeTriangleNormal> kEdgeNormals = {
     {"facet", EdgeTriangleNormal::Facet},
     {"vertex_mean", EdgeTriangleNormal::VertexMean}};
@@ -104,6 +107,12 @@ choiceName(EdgeTriangleNormal value)
   return nameIn(kEdgeNormals, value);
 }
 
+std::string
+choiceName(ViewProjection value)
+{
+  return nameIn(kProjections, value);
+}
+
 bool
 optionsGivenOnce(int argc,
                  char** argv,
@@ -144,6 +153,7 @@ segmentationFlags()
                                                  "-angle_step_rad",
                                                  "-min_split_points",
                                                  "-backend",
+                                                 "-projection",
                                                  "-threads"};
   return flags;
 }
@@ -193,6 +203,10 @@ printSegmentationHelp()
              d.angle_quantization);
   print_info(
       "  -backend NAME          Delaunay backend: sweep, boost or vtk (default sweep)\n");
+  print_info("  -projection NAME       directions to angles: forward (paper's eq. 1; "
+             "points behind the sensor are left out) or panoramic (azimuth and "
+             "elevation, the mesh closed around the sensor: a spinning lidar) (default "
+             "forward)\n");
   print_info("  -threads N             threads of the parallel stages; 0 = automatic: "
              "OMP_NUM_THREADS, else the CPUs the process may use (default %d; the "
              "result does not depend on it)\n",
@@ -222,6 +236,7 @@ parseSegmentationOptions(int argc, char** argv, SelectiveSegmentationParameters&
                    kNormalTriangles,
                    p.point_normal_triangles) ||
       !parseChoice(argc, argv, "-edge_normal", kEdgeNormals, p.edge_triangle_normal) ||
+      !parseChoice(argc, argv, "-projection", kProjections, p.projection) ||
       !parseChoice(argc,
                    argv,
                    "-backend",

@@ -53,11 +53,12 @@ const std::vector<std::string>& segmentationFlags();
 void printSegmentationHelp();
 
 /** \brief The command-line name of an enum option's value (as -segment_weight,
- * -spread_frame, -normal_triangles and -edge_normal take it). */
+ * -spread_frame, -normal_triangles, -edge_normal and -projection take it). */
 std::string choiceName(pcl::selective_seg::SegmentNormalWeight value);
 std::string choiceName(pcl::selective_seg::NormalSpreadFrame value);
 std::string choiceName(pcl::selective_seg::PointNormalTriangles value);
 std::string choiceName(pcl::selective_seg::EdgeTriangleNormal value);
+std::string choiceName(pcl::selective_seg::ViewProjection value);
 
 /** \brief Read those flags into \a params (degrees on the command line, radians in the
  * struct) and validate the result.

@@ -110,6 +110,24 @@ SelectiveSegmentationParameters::validate(std::string* why) const
                   isDelaunayBackendAvailable(DelaunayBackend::Vtk)
                       ? "sweep, boost or vtk (DelaunayBackend 2, 0 or 1)"
                       : "sweep, boost (DelaunayBackend 2, 0; vtk needs a build with VTK)");
+  if (projection != ViewProjection::Forward && projection != ViewProjection::Panoramic)
+    return reject(why,
+                  "projection",
+                  static_cast<int>(projection),
+                  "forward or panoramic (ViewProjection 0 or 1)");
+  if (projection == ViewProjection::Panoramic) {
+    if (angle_quantization < 1e-7)
+      return reject(why,
+                    "angle_quantization [rad]",
+                    angle_quantization,
+                    "[1e-7, 1e-2] with the panoramic projection");
+    if (delaunay_backend == DelaunayBackend::Vtk) {
+      if (why)
+        *why = "parameter delaunay_backend = vtk cannot triangulate the panoramic "
+               "projection: use sweep or boost (exact backends)";
+      return false;
+    }
+  }
   if (!isDelaunayBackendAvailable(delaunay_backend)) {
     if (why)
       *why = std::string("parameter delaunay_backend = ") + toString(delaunay_backend) +

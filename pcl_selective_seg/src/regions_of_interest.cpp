@@ -699,6 +699,14 @@ computeRegionsOfInterest(const SegmentationResult& result,
     PCL_ERROR("[pcl::selective_seg::computeRegionsOfInterest] %s\n", why.c_str());
     return false;
   }
+  if (tri.projection != ViewProjection::Forward) {
+    // The windows are rectangles in eq. 1's (theta, phi) on the plane z = 1 (their
+    // solid angle, the rays of a finer scan): a panorama has no such plane.
+    PCL_ERROR("[pcl::selective_seg::computeRegionsOfInterest] the triangulation uses "
+              "the panoramic projection; regions of interest are defined for the "
+              "forward projection (eq. 1) only\n");
+    return false;
+  }
   const std::size_t nv = tri.vertex_point.size();
   if (tri.vertex_angles.size() != nv || tri.vertex_positions.size() != nv ||
       result.labels.size() != tri.point_vertex.size() ||

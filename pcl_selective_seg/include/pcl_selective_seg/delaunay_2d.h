@@ -112,6 +112,52 @@ PCL_EXPORTS bool delaunay2d(const std::vector<QuantizedPoint>& points,
                             std::string* error = nullptr,
                             unsigned int num_threads = 1);
 
+/** \brief Delaunay triangulation of distinct points on a cylinder: x is periodic.
+ *
+ * The points are triangulated in a strip that repeats those within a margin of either
+ * end on the other side (x +- \a period), with two periodic rows of 64 sentinels a
+ * sixty-fourth of the period below and above the points; a triangle is kept when no
+ * corner is a sentinel and the lexicographically smallest corner is one of the points
+ * themselves, and named over their ids. The sentinels stand in for the points' own
+ * lower and upper hulls, rows of nearly equal y whose slivers have circles far wider
+ * than any margin: the mesh ends where the points end, without those slivers, and a
+ * point that only a sentinel's triangles reach has no triangle. Every kept triangle is
+ * a Delaunay triangle of the points on the cylinder (its circle is empty of the
+ * points and the sentinels). The margin starts at period / 32 and doubles, up to period
+ * / 2, until the kept triangles close the cylinder: every point a corner, no directed
+ * edge used twice, every boundary loop winding once around the cylinder (the lower and
+ * upper hulls; a seam left open or a hole makes a loop that does not), and every
+ * triangle near the seam Delaunay against its neighbours (the exact in-circle test, a
+ * neighbour's corner shifted by the period where the triangles meet across the seam).
+ * A triangle wider than the period (two of its corners one point: where one point
+ * rises above all others, the hull runs from it to its own copy) is left out. Inside
+ * the strip the triangulation is delaunay2d()'s, co-circular points included: the
+ * canonical fan rule depends on coordinate differences only, so it splits a group the
+ * same way on both sides of the seam.
+ *
+ * \param[in] points distinct points with x in [-period / 2, period / 2), |y| <=
+ *            kMaxDelaunayCoordinate - period / 64
+ * \param[in] period an even number in [4, kMaxDelaunayCoordinate]
+ * \param[in] backend BoostVoronoi or Sweep (an exact backend)
+ * \param[out] triangles counter-clockwise, in canonical order (as delaunay2d())
+ * \param[out] neighbours the adjacency (computeTriangleNeighbours()), -1 only along
+ *             the open ends of the cylinder (the smallest and largest y)
+ * \param[out] closed whether the triangulation closes around the cylinder. When no
+ *             margin up to period / 2 gives a closed triangulation (a few points
+ *             farther apart than a quarter period), the result is delaunay2d() of
+ *             the points in the plane, open at the seam, and \a closed is false.
+ * \param[out] error the reason for a failure (may be null)
+ * \param[in] num_threads threads of the adjacency (the result does not depend on it)
+ * \return false on a precondition violation (range, duplicates, period, backend). */
+PCL_EXPORTS bool delaunay2dPeriodic(const std::vector<QuantizedPoint>& points,
+                                    std::int32_t period,
+                                    DelaunayBackend backend,
+                                    std::vector<Triangle>& triangles,
+                                    std::vector<Triangle>& neighbours,
+                                    bool& closed,
+                                    std::string* error = nullptr,
+                                    unsigned int num_threads = 1);
+
 /** \brief Triangle adjacency of a triangle mesh.
  *
  * \param[in] triangles triangles over vertex ids 0..num_vertices-1, consistently

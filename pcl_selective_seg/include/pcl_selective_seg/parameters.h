@@ -79,6 +79,21 @@ enum class PointNormalTriangles : std::uint8_t {
   NotEdgeOn = 1
 };
 
+/** \brief How stage 1 maps a point's direction in the sensor frame to the plane of the
+ * triangulation. */
+enum class ViewProjection : std::uint8_t {
+  /** The paper's eq. 1: theta = atan2(x, z), phi = atan2(y, z), for a forward-looking
+   * sensor; points at or behind the sensor plane (z <= 0) have no image. */
+  Forward = 0,
+  /** A panorama (a spinning lidar, a pan-tilt laser): azimuth theta = atan2(x, z) in
+   * (-pi, pi] and elevation phi = atan2(y, sqrt(x^2 + z^2)) in [-pi/2, pi/2], with y
+   * the spin axis. Every point but the sensor's own position has an image; the
+   * triangulation is periodic in theta (delaunay2dPeriodic()), so the mesh closes
+   * behind the sensor. theta and phi agree with eq. 1 in the plane x = 0. Not the
+   * paper's; see docs/parameters.md. */
+  Panoramic = 1
+};
+
 /** \brief Every parameter of SelectiveSegmentation, with the paper's defaults.
  *
  * Angles are in radians, lengths in metres (the cloud's unit). docs/parameters.md gives
@@ -150,6 +165,11 @@ struct PCL_EXPORTS SelectiveSegmentationParameters {
    * triangulation [rad]. Points falling on one grid position share one mesh vertex.
    * Default 1e-7 rad (0.1 micrometre at 1 m). Valid: [2.5e-8, 1e-2]. */
   double angle_quantization = 1e-7;
+
+  /** \brief Stage 1's mapping of directions. Default: Forward, the paper's eq. 1.
+   * Panoramic needs an exact backend and angle_quantization >= 1e-7 (the periodic
+   * strip must fit the exact predicates' coordinate range). */
+  ViewProjection projection = ViewProjection::Forward;
 
   /** \brief Threads for the parallel stages; 0 = automatic (defaultThreads()). The
    * result is identical for any value. Valid: [0, 1024]. */

@@ -235,6 +235,8 @@ fisherConfidenceAngle(std::size_t n, double resultant, double confidence);
  * the selected windows; empty on failure \param[out] stats if non-null: counts of
  * evidence and windows \return false (with PCL_ERROR saying why) on invalid parameters
  * or a result that does not belong to the triangulation. An empty scan gives no region.
+ * A panoramic triangulation (ViewProjection::Panoramic) is refused: the windows are
+ * rectangles of eq. 1's angles.
  */
 PCL_EXPORTS bool computeRegionsOfInterest(const SegmentationResult& result,
                                           const SphericalTriangulation& triangulation,

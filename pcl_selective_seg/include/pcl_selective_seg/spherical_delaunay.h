@@ -14,6 +14,7 @@
 #include <pcl/surface/reconstruction.h>
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -37,7 +38,8 @@ quantizedAngle(double y, double x, double step);
 enum PointStatus : pcl::index_t {
   kOutsideIndices = -1, ///< not in the indices
   kNonFinite = -2,      ///< NaN or Inf coordinate
-  kBehindSensor = -3    ///< z <= 0 in the sensor frame
+  kBehindSensor = -3    ///< z <= 0 in the sensor frame (ViewProjection::Forward), or
+                        ///< at the sensor's own position (ViewProjection::Panoramic)
 };
 
 /** \brief The triangulation of a cloud in spherical space (paper, eq. 1 and Sec.
@@ -51,7 +53,9 @@ struct SphericalTriangulation {
   /** \#V the input point that represents each vertex: among the points sharing its
    * angles, the nearest to the sensor (ties: smallest x, y, z). */
   pcl::Indices vertex_point;
-  /** \#V quantized (theta, phi) of each vertex: angle / angle_quantization, rounded. */
+  /** \#V quantized (theta, phi) of each vertex: angle / angle_quantization, rounded.
+   * With the panoramic projection theta lies in [-period / 2, period / 2), period =
+   * 2 lround(pi / angle_quantization) (panoramicPeriod()). */
   std::vector<QuantizedPoint> vertex_angles;
   /** \#V position of each vertex's representative point in the sensor frame [m]. */
   std::vector<Eigen::Vector3f> vertex_positions;
@@ -64,7 +68,20 @@ struct SphericalTriangulation {
   std::size_t num_non_finite = 0;
   std::size_t num_behind_sensor = 0;
   double angle_quantization = 0.0; ///< [rad]
+  /** How the angles were made. */
+  ViewProjection projection = ViewProjection::Forward;
+  /** Panoramic only: whether the triangles close the mesh around the sensor
+   * (delaunay2dPeriodic()'s \a closed). */
+  bool seam_closed = false;
 };
+
+/** \brief The period of the panoramic theta in quantization steps: 2 lround(pi /
+ * angle_quantization). */
+inline std::int32_t
+panoramicPeriod(double angle_quantization)
+{
+  return static_cast<std::int32_t>(2 * std::lround(M_PI / angle_quantization));
+}
 
 /** \brief Delaunay triangulation of a cloud in the sensor's spherical space (theta,
  * phi).
@@ -77,6 +94,10 @@ struct SphericalTriangulation {
  *
  * Points that are not finite or lie at or behind the sensor plane (z <= 0) get no
  * vertex. Points with equal quantized angles share one vertex.
+ *
+ * setProjection(ViewProjection::Panoramic) maps the directions to azimuth and
+ * elevation instead, for a sensor that sees all around; the triangulation is then
+ * periodic in the azimuth and closes behind the sensor (delaunay2dPeriodic()).
  *
  * Use it as any pcl::MeshConstruction: reconstruct(pcl::PolygonMesh&) gives the mesh
  * over the input cloud; getTriangulation() the vertex map and triangle adjacency.
@@ -108,7 +129,12 @@ public:
     triangulation_.neighbours.clear();
   }
 
-  /** \brief Grid step of the angle quantization [rad], in [2.5e-8, 1e-2]. */
+  /** \brief Stage 1's mapping (default ViewProjection::Forward, eq. 1). */
+  void setProjection(ViewProjection projection) { projection_ = projection; }
+  ViewProjection getProjection() const { return projection_; }
+
+  /** \brief Grid step of the angle quantization [rad], in [2.5e-8, 1e-2] ([1e-7,
+   * 1e-2] with the panoramic projection). */
   void setAngleQuantization(double step) { angle_quantization_ = step; }
   double getAngleQuantization() const { return angle_quantization_; }
 
@@ -158,8 +184,8 @@ public:
    * \param[out] moved_vertices vertices (new ids) whose representative point changed to
    *             a new point nearer to the sensor
    * \return false when the update is impossible (no previous triangulation with
-   *         triangles, inconsistent input); the triangulation is then unchanged and
-   *         triangulate() should run instead. */
+   *         triangles, a panoramic one, inconsistent input); the triangulation is then
+   * unchanged and triangulate() should run instead. */
   bool insertPoints(std::size_t first_new_point,
                     std::vector<Triangle>& neighbours,
                     DelaunayInsertion& info,
@@ -189,6 +215,10 @@ protected:
   std::pair<std::uint64_t, pcl::index_t> projectPoint(const Eigen::Affine3d& pose,
                                                       pcl::index_t index) const;
 
+  /** \brief projectPoint() with the panoramic projection, \a s in the sensor frame. */
+  std::pair<std::uint64_t, pcl::index_t> projectPanoramic(const Eigen::Vector3d& s,
+                                                          pcl::index_t index) const;
+
   /** \brief The representative of the points sorted[begin, end) (equal angles). */
   pcl::index_t
   representative(const std::vector<std::pair<std::uint64_t, pcl::index_t>>& sorted,
@@ -217,6 +247,7 @@ protected:
 private:
   DelaunayBackend backend_ = DelaunayBackend::Sweep;
   double angle_quantization_ = 1e-7;
+  ViewProjection projection_ = ViewProjection::Forward;
   Eigen::Affine3f sensor_pose_ = Eigen::Affine3f::Identity();
   bool has_sensor_pose_ = false;
   SphericalTriangulation triangulation_;

@@ -91,6 +91,7 @@ SelectiveSegmentation<PointT>::triangulate()
   delaunay_.setIndices(indices_);
   delaunay_.setBackend(params_.delaunay_backend);
   delaunay_.setAngleQuantization(params_.angle_quantization);
+  delaunay_.setProjection(params_.projection);
   delaunay_.setNumberOfThreads(static_cast<unsigned int>(params_.num_threads));
   // The adjacency comes with the triangles (the sweep reads it off its half-edges) and
   // moves into the result; update() keeps it there, not in the triangulation.
@@ -107,8 +108,11 @@ SelectiveSegmentation<PointT>::triangulate()
                 "no usable point among " + std::to_string(input_->size()) + ": " +
                     std::to_string(tri.num_non_finite) + " non-finite, " +
                     std::to_string(tri.num_behind_sensor) +
-                    " at or behind the sensor plane (z <= 0 in the sensor frame; check "
-                    "sensor_origin_/sensor_orientation_ or setSensorPose()), " +
+                    (tri.projection == ViewProjection::Panoramic
+                         ? " at the sensor's position, "
+                         : " at or behind the sensor plane (z <= 0 in the sensor "
+                           "frame; check sensor_origin_/sensor_orientation_ or "
+                           "setSensorPose(), or use the panoramic projection), ") +
                     std::to_string(tri.num_outside_indices) + " outside the indices");
   if (tri.triangles.empty())
     return fail("extract",

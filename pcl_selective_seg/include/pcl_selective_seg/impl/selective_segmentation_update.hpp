@@ -100,6 +100,8 @@ SelectiveSegmentation<PointT>::updateMesh(std::size_t first_new_point, bool& fai
   // exact backends (VTK's output is not the canonical triangulation).
   const bool same_mesh_parameters =
       params_.angle_quantization == mesh_params_.angle_quantization &&
+      params_.projection == ViewProjection::Forward &&
+      mesh_params_.projection == ViewProjection::Forward &&
       params_.max_view_incidence_angle == mesh_params_.max_view_incidence_angle &&
       params_.normal_rings == mesh_params_.normal_rings &&
       params_.point_normal_triangles == mesh_params_.point_normal_triangles &&

@@ -151,6 +151,7 @@ SphericalDelaunay<PointT>::projectAndMergeVertices(SphericalTriangulation& resul
     keyed[k] = projectPoint(pose, indices[k]);
   result.point_vertex.assign(cloud.size(), kOutsideIndices);
   result.angle_quantization = angle_quantization_;
+  result.projection = projection_;
   for (std::size_t k = 0; k < keyed.size(); ++k)
     if (keyed[k].first == detail::kExcludedKey)
       result.point_vertex[indices[k]] = keyed[k].second;
@@ -173,6 +174,8 @@ SphericalDelaunay<PointT>::projectPoint(const Eigen::Affine3d& pose,
   if (!pcl::isXYZFinite((*this->input_)[index]))
     return {detail::kExcludedKey, kNonFinite};
   const Eigen::Vector3d s = toSensorFrame(pose, index);
+  if (projection_ == ViewProjection::Panoramic)
+    return projectPanoramic(s, index);
   if (!(s.z() > 0.0))
     return {detail::kExcludedKey, kBehindSensor};
   // eq. 1; both angles lie in (-pi/2, pi/2) because z > 0.
@@ -181,6 +184,26 @@ SphericalDelaunay<PointT>::projectPoint(const Eigen::Affine3d& pose,
           detail::quantizedAngle(s.x(), s.z(), angle_quantization_)),
       static_cast<std::int32_t>(
           detail::quantizedAngle(s.y(), s.z(), angle_quantization_))};
+  return {detail::angleKey(q), index};
+}
+
+template <typename PointT>
+std::pair<std::uint64_t, pcl::index_t>
+SphericalDelaunay<PointT>::projectPanoramic(const Eigen::Vector3d& s,
+                                            pcl::index_t index) const
+{
+  const double horizontal = std::hypot(s.x(), s.z());
+  if (!(horizontal > 0.0 || s.y() != 0.0))
+    return {detail::kExcludedKey, kBehindSensor}; // the sensor's own position
+  const long period = panoramicPeriod(angle_quantization_);
+  long theta = std::lround(std::atan2(s.x(), s.z()) / angle_quantization_);
+  if (theta >= period / 2) // +pi is -pi
+    theta -= period;
+  const long phi = horizontal > 0.0
+                       ? detail::quantizedAngle(s.y(), horizontal, angle_quantization_)
+                       : std::lround(std::atan2(s.y(), 0.0) / angle_quantization_);
+  const QuantizedPoint q{static_cast<std::int32_t>(theta),
+                         static_cast<std::int32_t>(phi)};
   return {detail::angleKey(q), index};
 }
 
@@ -270,6 +293,24 @@ bool
 SphericalDelaunay<PointT>::triangulateVertices()
 {
   std::string why;
+  if (projection_ == ViewProjection::Panoramic) {
+    std::vector<Triangle> neighbours;
+    const bool ok = delaunay2dPeriodic(triangulation_.vertex_angles,
+                                       panoramicPeriod(angle_quantization_),
+                                       backend_,
+                                       triangulation_.triangles,
+                                       neighbours,
+                                       triangulation_.seam_closed,
+                                       &why,
+                                       num_threads_);
+    if (!ok)
+      PCL_ERROR("[pcl::selective_seg::%s::triangulate] %s\n",
+                getClassName().c_str(),
+                why.c_str());
+    if (compute_neighbours_)
+      triangulation_.neighbours.swap(neighbours);
+    return ok;
+  }
   const bool ok =
       compute_neighbours_
           ? delaunay2d(triangulation_.vertex_angles,
@@ -303,6 +344,16 @@ SphericalDelaunay<PointT>::triangulate()
               "outside [2.5e-8, 1e-2]\n",
               getClassName().c_str(),
               angle_quantization_);
+    return false;
+  }
+  if (projection_ == ViewProjection::Panoramic &&
+      (angle_quantization_ < 1e-7 || backend_ == DelaunayBackend::Vtk)) {
+    PCL_ERROR("[pcl::selective_seg::%s::triangulate] the panoramic projection needs an "
+              "angle quantization of at least 1e-7 rad (not %g) and an exact backend "
+              "(sweep or boost, not %s)\n",
+              getClassName().c_str(),
+              angle_quantization_,
+              toString(backend_));
     return false;
   }
   std::string bad_pose;

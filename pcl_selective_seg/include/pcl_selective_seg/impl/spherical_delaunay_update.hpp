@@ -29,7 +29,9 @@ SphericalDelaunay<PointT>::insertPoints(std::size_t first_new_point,
       neighbours.size() != tri.triangles.size() ||
       tri.point_vertex.size() != first_new_point ||
       first_new_point > this->input_->size() ||
-      tri.angle_quantization != angle_quantization_ || !sensorPoseIsRigid())
+      tri.angle_quantization != angle_quantization_ || !sensorPoseIsRigid() ||
+      tri.projection != ViewProjection::Forward ||
+      projection_ != ViewProjection::Forward)
     return false;
   if (!this->initCompute())
     return false;

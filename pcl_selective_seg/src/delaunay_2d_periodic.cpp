@@ -1,0 +1,321 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
+ */
+
+#include <pcl_selective_seg/delaunay_2d.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <string>
+
+#include "delaunay_2d_backends.h"
+
+namespace pcl {
+namespace selective_seg {
+
+namespace {
+
+using detail::inCircle;
+using detail::setError;
+
+/** The points (ids 0..n-1), then copies shifted by -+ period of those within \a
+ * margin of the ends. */
+struct Strip {
+  std::vector<QuantizedPoint> points;
+  /** For copy k (strip id n + k): the id of the point it repeats. */
+  std::vector<index_t> original;
+
+  index_t pointOf(index_t id) const
+  {
+    const auto n = static_cast<index_t>(points.size() - original.size());
+    return id < n ? id : original[id - n];
+  }
+};
+
+void
+makeStrip(const std::vector<QuantizedPoint>& points,
+          std::int32_t period,
+          std::int32_t margin,
+          Strip& strip)
+{
+  const std::int32_t half = period / 2;
+  strip.points = points;
+  strip.original.clear();
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const QuantizedPoint& p = points[i];
+    // margin <= half: no point is repeated on both sides.
+    if (p[0] < -half + margin) {
+      strip.points.push_back({p[0] + period, p[1]});
+      strip.original.push_back(static_cast<index_t>(i));
+    } else if (p[0] >= half - margin) {
+      strip.points.push_back({p[0] - period, p[1]});
+      strip.original.push_back(static_cast<index_t>(i));
+    }
+  }
+}
+
+bool
+lexicographicallyLess(const QuantizedPoint& a, const QuantizedPoint& b)
+{
+  return a[0] < b[0] || (a[0] == b[0] && a[1] < b[1]);
+}
+
+/** The strip's triangles whose smallest corner is a point, not a copy: each triangle
+ * of the cylinder once; of those, the triangles over the first \a num_points points
+ * (not the sentinels after them). \a kept over point ids, \a unwrapped over strip
+ * ids. */
+void
+keepOneCopy(const Strip& strip,
+            std::size_t num_originals,
+            std::size_t num_points,
+            const std::vector<Triangle>& strip_triangles,
+            std::vector<Triangle>& kept,
+            std::vector<Triangle>& unwrapped)
+{
+  kept.clear();
+  unwrapped.clear();
+  for (const Triangle& t : strip_triangles) {
+    index_t smallest = t[0];
+    for (int i = 1; i < 3; ++i)
+      if (lexicographicallyLess(strip.points[t[i]], strip.points[smallest]))
+        smallest = t[i];
+    if (static_cast<std::size_t>(smallest) >= num_originals)
+      continue;
+    const Triangle mapped{
+        strip.pointOf(t[0]), strip.pointOf(t[1]), strip.pointOf(t[2])};
+    // A triangle wider than the period (two corners one point: a hull edge from a
+    // point to its own copy, where one point rises above all others) is no triangle
+    // of the cylinder's mesh.
+    if (mapped[0] == mapped[1] || mapped[1] == mapped[2] || mapped[2] == mapped[0])
+      continue;
+    if (static_cast<std::size_t>(std::max({mapped[0], mapped[1], mapped[2]})) >=
+        num_points)
+      continue;
+    kept.push_back(mapped);
+    unwrapped.push_back(t);
+  }
+}
+
+/** Whether every boundary loop of the kept triangles winds once around the cylinder:
+ * the lower and upper hulls do; a seam left open, or a hole, makes a loop that does
+ * not (its steps in x, each measured within its triangle, add up to 0 instead of the
+ * period). At most one loop each way; no vertex starts two boundary edges. */
+bool
+boundaryWindsAround(const Strip& strip,
+                    std::int32_t period,
+                    const std::vector<Triangle>& kept,
+                    const std::vector<Triangle>& unwrapped,
+                    const std::vector<Triangle>& neighbours)
+{
+  struct Edge {
+    index_t from, to;
+    std::int64_t dx;
+  };
+  std::vector<Edge> edges;
+  for (std::size_t t = 0; t < kept.size(); ++t)
+    for (int i = 0; i < 3; ++i)
+      if (neighbours[t][i] < 0) {
+        const int a = (i + 1) % 3, b = (i + 2) % 3;
+        edges.push_back({kept[t][a],
+                         kept[t][b],
+                         std::int64_t{strip.points[unwrapped[t][b]][0]} -
+                             strip.points[unwrapped[t][a]][0]});
+      }
+  std::sort(edges.begin(), edges.end(), [](const Edge& e, const Edge& f) {
+    return e.from < f.from;
+  });
+  for (std::size_t k = 1; k < edges.size(); ++k)
+    if (edges[k].from == edges[k - 1].from)
+      return false;
+  const auto next = [&](index_t from) -> std::ptrdiff_t {
+    const auto it = std::lower_bound(
+        edges.begin(), edges.end(), from, [](const Edge& e, index_t v) {
+          return e.from < v;
+        });
+    return it != edges.end() && it->from == from ? it - edges.begin() : -1;
+  };
+  std::vector<bool> visited(edges.size(), false);
+  int forward = 0, backward = 0;
+  for (std::size_t start = 0; start < edges.size(); ++start) {
+    if (visited[start])
+      continue;
+    std::int64_t winding = 0;
+    for (std::ptrdiff_t e = static_cast<std::ptrdiff_t>(start); !visited[e];) {
+      visited[e] = true;
+      winding += edges[e].dx;
+      e = next(edges[e].to);
+      if (e < 0)
+        return false; // a boundary that does not close
+    }
+    if (winding == period)
+      ++forward;
+    else if (winding == -std::int64_t{period})
+      ++backward;
+    else
+      return false;
+  }
+  return forward <= 1 && backward <= 1;
+}
+
+/** Whether the kept triangles triangulate the cylinder (delaunay2dPeriodic()'s tests).
+ * \a neighbours: their adjacency. */
+bool
+closesCylinder(const Strip& strip,
+               std::int32_t period,
+               std::int32_t margin,
+               const std::vector<Triangle>& kept,
+               const std::vector<Triangle>& unwrapped,
+               const std::vector<Triangle>& neighbours)
+{
+  if (!boundaryWindsAround(strip, period, kept, unwrapped, neighbours))
+    return false;
+  // Away from the seam the kept triangles are the strip's, a planar triangulation.
+  const std::int32_t half = period / 2;
+  const auto near_seam = [&](const Triangle& u) {
+    for (const index_t id : u) {
+      const std::int32_t x = strip.points[id][0];
+      if (x < -half + margin || x >= half - margin)
+        return true;
+    }
+    return false;
+  };
+  std::vector<std::uint64_t> directed;
+  std::vector<std::size_t> seam;
+  for (std::size_t t = 0; t < kept.size(); ++t) {
+    if (!near_seam(unwrapped[t]))
+      continue;
+    seam.push_back(t);
+    for (int i = 0; i < 3; ++i)
+      directed.push_back((std::uint64_t{static_cast<std::uint32_t>(kept[t][i])} << 32) |
+                         static_cast<std::uint32_t>(kept[t][(i + 1) % 3]));
+  }
+  std::sort(directed.begin(), directed.end());
+  if (std::adjacent_find(directed.begin(), directed.end()) != directed.end())
+    return false; // two triangles overlap
+  for (const std::size_t t : seam) {
+    const Triangle& corners = unwrapped[t];
+    for (int i = 0; i < 3; ++i) {
+      const index_t u = neighbours[t][i];
+      if (u < 0)
+        continue;
+      const index_t a = kept[t][(i + 1) % 3], b = kept[t][(i + 2) % 3];
+      int at_a = -1, opposite = -1;
+      for (int k = 0; k < 3; ++k) {
+        if (kept[u][k] == a)
+          at_a = k;
+        else if (kept[u][k] != b)
+          opposite = k;
+      }
+      if (at_a < 0 || opposite < 0)
+        return false;
+      // The neighbour's corner where the two triangles meet: shifted by the period
+      // when one of them holds a copy of the shared corner.
+      const std::int32_t shift =
+          strip.points[corners[(i + 1) % 3]][0] - strip.points[unwrapped[u][at_a]][0];
+      QuantizedPoint far = strip.points[unwrapped[u][opposite]];
+      far[0] += shift;
+      if (inCircle(strip.points[corners[0]],
+                   strip.points[corners[1]],
+                   strip.points[corners[2]],
+                   far) > 0)
+        return false;
+    }
+  }
+  return true;
+}
+
+} // namespace
+
+bool
+delaunay2dPeriodic(const std::vector<QuantizedPoint>& points,
+                   std::int32_t period,
+                   DelaunayBackend backend,
+                   std::vector<Triangle>& triangles,
+                   std::vector<Triangle>& neighbours,
+                   bool& closed,
+                   std::string* error,
+                   unsigned int num_threads)
+{
+  triangles.clear();
+  neighbours.clear();
+  closed = false;
+  if (period < 4 || period % 2 != 0 || period > kMaxDelaunayCoordinate) {
+    setError(error,
+             "delaunay2dPeriodic: the period " + std::to_string(period) +
+                 " is not an even number in [4, " +
+                 std::to_string(kMaxDelaunayCoordinate) + "]");
+    return false;
+  }
+  if (backend == DelaunayBackend::Vtk) {
+    setError(error,
+             "delaunay2dPeriodic: needs an exact backend (sweep or boost), not vtk");
+    return false;
+  }
+  const std::int32_t half = period / 2;
+  for (std::size_t i = 0; i < points.size(); ++i)
+    if (points[i][0] < -half || points[i][0] >= half) {
+      setError(error,
+               "delaunay2dPeriodic: point " + std::to_string(i) +
+                   " has x = " + std::to_string(points[i][0]) + ", outside [" +
+                   std::to_string(-half) + ", " + std::to_string(half) + ")");
+      return false;
+    }
+  // Two rows of sentinels, periodic, a sixty-fourth of the period below and above the
+  // points: the strip's hull is theirs, so the points' own lower and upper hulls (rows
+  // of nearly equal y, whose triangles have circles far wider than any margin) never
+  // decide the triangulation near the seam. The sentinels' triangles are dropped.
+  std::int32_t y_min = 0, y_max = 0;
+  if (!points.empty()) {
+    const auto [lo, hi] = std::minmax_element(
+        points.begin(),
+        points.end(),
+        [](const QuantizedPoint& a, const QuantizedPoint& b) { return a[1] < b[1]; });
+    y_min = (*lo)[1];
+    y_max = (*hi)[1];
+  }
+  const std::int32_t gap = std::max(1, period / 64);
+  if (std::int64_t{y_min} - gap < -kMaxDelaunayCoordinate ||
+      std::int64_t{y_max} + gap > kMaxDelaunayCoordinate) {
+    setError(error,
+             "delaunay2dPeriodic: y must lie within +-(" +
+                 std::to_string(kMaxDelaunayCoordinate) + " - period / 64)");
+    return false;
+  }
+  std::vector<QuantizedPoint> with_sentinels = points;
+  const std::int64_t sentinels = std::min<std::int64_t>(64, period);
+  for (std::int64_t j = 0; j < sentinels; ++j) {
+    const auto x = static_cast<std::int32_t>(-half + j * period / sentinels);
+    with_sentinels.push_back({x, y_min - gap});
+    with_sentinels.push_back({x, y_max + gap});
+  }
+  Strip strip;
+  std::vector<Triangle> strip_triangles, unwrapped;
+  for (std::int32_t margin = std::min(half, std::max(1, period / 32));;
+       margin = std::min(half, 2 * margin)) {
+    makeStrip(with_sentinels, period, margin, strip);
+    if (!delaunay2d(strip.points, backend, strip_triangles, error))
+      return false;
+    keepOneCopy(strip,
+                with_sentinels.size(),
+                points.size(),
+                strip_triangles,
+                triangles,
+                unwrapped);
+    computeTriangleNeighbours(triangles, points.size(), neighbours, num_threads);
+    if (!triangles.empty() &&
+        closesCylinder(strip, period, margin, triangles, unwrapped, neighbours)) {
+      closed = true;
+      detail::canonicalize(
+          triangles, points.size(), &neighbours, static_cast<int>(num_threads));
+      return true;
+    }
+    if (margin == half)
+      break;
+  }
+  return delaunay2d(points, backend, triangles, neighbours, error, num_threads);
+}
+
+} // namespace selective_seg
+} // namespace pcl

@@ -1,0 +1,343 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
+ */
+
+// The panoramic projection (ViewProjection::Panoramic): the periodic triangulation on
+// its own (every triangle Delaunay on the cylinder, the mesh closed across the seam),
+// and the segmentation of a room scanned all around from its middle.
+
+#include <pcl_selective_seg/regions_of_interest.h>
+#include <pcl_selective_seg/selective_segmentation.h>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numeric>
+#include <random>
+#include <set>
+
+using namespace pcl::selective_seg;
+using pcl::index_t;
+using Cloud = pcl::PointCloud<pcl::PointXYZ>;
+using Seg = SelectiveSegmentation<pcl::PointXYZ>;
+
+namespace {
+
+__extension__ typedef __int128 Int128;
+
+/** > 0: d strictly inside the circle of the counter-clockwise (a, b, c). */
+Int128
+inCircle(const std::array<std::int64_t, 2>& a,
+         const std::array<std::int64_t, 2>& b,
+         const std::array<std::int64_t, 2>& c,
+         const std::array<std::int64_t, 2>& d)
+{
+  const Int128 adx = a[0] - d[0], ady = a[1] - d[1], bdx = b[0] - d[0],
+               bdy = b[1] - d[1], cdx = c[0] - d[0], cdy = c[1] - d[1];
+  return (adx * adx + ady * ady) * (bdx * cdy - cdx * bdy) +
+         (bdx * bdx + bdy * bdy) * (cdx * ady - adx * cdy) +
+         (cdx * cdx + cdy * cdy) * (adx * bdy - bdx * ady);
+}
+
+std::vector<QuantizedPoint>
+randomCylinderPoints(std::size_t n,
+                     std::int32_t period,
+                     std::int32_t height,
+                     unsigned seed)
+{
+  std::mt19937 rng(seed);
+  std::uniform_int_distribution<std::int32_t> x(-period / 2, period / 2 - 1),
+      y(0, height);
+  std::set<QuantizedPoint> seen;
+  std::vector<QuantizedPoint> points;
+  while (points.size() < n) {
+    const QuantizedPoint p{x(rng), y(rng)};
+    if (seen.insert(p).second)
+      points.push_back(p);
+  }
+  return points;
+}
+
+/** Each triangle unwrapped next to its first corner: x of the others moved by a
+ * multiple of the period to lie within half a period of it. */
+std::array<std::array<std::int64_t, 2>, 3>
+unwrap(const std::vector<QuantizedPoint>& points,
+       const Triangle& t,
+       std::int32_t period)
+{
+  std::array<std::array<std::int64_t, 2>, 3> out;
+  for (int i = 0; i < 3; ++i) {
+    std::int64_t x = points[t[i]][0];
+    const std::int64_t x0 = points[t[0]][0];
+    while (x - x0 > period / 2)
+      x -= period;
+    while (x0 - x > period / 2)
+      x += period;
+    out[i] = {x, points[t[i]][1]};
+  }
+  return out;
+}
+
+} // namespace
+
+TEST(Delaunay2dPeriodic, EveryTriangleIsDelaunayOnTheCylinderAndTheMeshCloses)
+{
+  const std::int32_t period = 100000;
+  for (unsigned seed = 1; seed <= 4; ++seed) {
+    const auto points = randomCylinderPoints(300, period, 30000, seed);
+    std::vector<Triangle> triangles, neighbours;
+    bool closed = false;
+    std::string why;
+    ASSERT_TRUE(delaunay2dPeriodic(
+        points, period, DelaunayBackend::Sweep, triangles, neighbours, closed, &why))
+        << why;
+    EXPECT_TRUE(closed);
+    std::size_t across_seam = 0, boundary = 0;
+    std::map<std::pair<index_t, index_t>, int> directed;
+    for (std::size_t t = 0; t < triangles.size(); ++t) {
+      const auto c = unwrap(points, triangles[t], period);
+      // Counter-clockwise once unwrapped; the seam crossed by some.
+      ASSERT_GT((c[1][0] - c[0][0]) * (c[2][1] - c[0][1]) -
+                    (c[1][1] - c[0][1]) * (c[2][0] - c[0][0]),
+                0);
+      across_seam += std::max({c[0][0], c[1][0], c[2][0]}) >= period / 2 ||
+                     std::min({c[0][0], c[1][0], c[2][0]}) < -period / 2;
+      // Empty circle against every point and its copies one period either way.
+      for (std::size_t p = 0; p < points.size(); ++p)
+        for (const std::int64_t shift : {-period, 0, period}) {
+          const std::array<std::int64_t, 2> d{points[p][0] + shift, points[p][1]};
+          ASSERT_LE(inCircle(c[0], c[1], c[2], d), 0)
+              << "seed " << seed << ", triangle " << t << ", point " << p;
+        }
+      for (int i = 0; i < 3; ++i) {
+        ++directed[{triangles[t][i], triangles[t][(i + 1) % 3]}];
+        boundary += neighbours[t][(i + 2) % 3] < 0;
+      }
+    }
+    EXPECT_GT(across_seam, 0u);
+    for (const auto& [edge, uses] : directed)
+      EXPECT_EQ(uses, 1);
+    // A triangulated annulus: F = 2 V - B (Euler characteristic 0) when every point
+    // is a corner; here the boundary is only the lower and upper ends.
+    std::set<index_t> corners;
+    for (const auto& t : triangles)
+      corners.insert(t.begin(), t.end());
+    EXPECT_EQ(static_cast<std::int64_t>(triangles.size()),
+              2 * static_cast<std::int64_t>(corners.size()) -
+                  static_cast<std::int64_t>(boundary));
+    // The same triangles from the other exact backend.
+    std::vector<Triangle> boost_triangles, boost_neighbours;
+    bool boost_closed = false;
+    ASSERT_TRUE(delaunay2dPeriodic(points,
+                                   period,
+                                   DelaunayBackend::BoostVoronoi,
+                                   boost_triangles,
+                                   boost_neighbours,
+                                   boost_closed));
+    EXPECT_EQ(boost_triangles, triangles);
+    EXPECT_EQ(boost_neighbours, neighbours);
+  }
+}
+
+TEST(Delaunay2dPeriodic, RefusesBadInput)
+{
+  std::vector<Triangle> triangles, neighbours;
+  bool closed = true;
+  std::string why;
+  const std::vector<QuantizedPoint> points{{0, 0}, {10, 0}, {5, 10}};
+  EXPECT_FALSE(delaunay2dPeriodic(
+      points, 7, DelaunayBackend::Sweep, triangles, neighbours, closed, &why));
+  EXPECT_NE(why.find("period"), std::string::npos) << why;
+  EXPECT_FALSE(delaunay2dPeriodic(
+      points, 16, DelaunayBackend::Sweep, triangles, neighbours, closed, &why));
+  EXPECT_NE(why.find("outside"), std::string::npos) << why;
+  EXPECT_FALSE(closed);
+  // Fewer than three points, or a few points far apart: no closed mesh, no failure.
+  EXPECT_TRUE(delaunay2dPeriodic(
+      {{0, 0}, {1, 1}}, 1000, DelaunayBackend::Sweep, triangles, neighbours, closed));
+  EXPECT_TRUE(triangles.empty());
+  EXPECT_FALSE(closed);
+}
+
+namespace {
+
+/** A box room, x in +-3, y (up) in +-1.5, z in +-4 m, scanned from its middle by a
+ * spinning sensor: jittered rays all around in azimuth, +-40 deg in elevation.
+ * \a face gets the wall each point lies on (0..5). */
+Cloud::Ptr
+scanRoom(std::vector<int>& face, unsigned seed = 7)
+{
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> jitter(0.0, 1.0);
+  const int num_azimuth = 600, num_elevation = 80;
+  const double half[3] = {3.0, 1.5, 4.0};
+  auto cloud = pcl::make_shared<Cloud>();
+  face.clear();
+  for (int i = 0; i < num_azimuth; ++i)
+    for (int j = 0; j < num_elevation; ++j) {
+      const double az = -M_PI + (i + jitter(rng)) * 2.0 * M_PI / num_azimuth;
+      const double el = -0.7 + (j + jitter(rng)) * 1.4 / num_elevation;
+      const double d[3] = {
+          std::cos(el) * std::sin(az), std::sin(el), std::cos(el) * std::cos(az)};
+      int axis = 0;
+      double t = 1e30;
+      for (int k = 0; k < 3; ++k)
+        if (std::abs(d[k]) > 0 && half[k] / std::abs(d[k]) < t) {
+          t = half[k] / std::abs(d[k]);
+          axis = k;
+        }
+      cloud->push_back(pcl::PointXYZ(static_cast<float>(t * d[0]),
+                                     static_cast<float>(t * d[1]),
+                                     static_cast<float>(t * d[2])));
+      face.push_back(2 * axis + (d[axis] > 0));
+    }
+  cloud->width = static_cast<std::uint32_t>(cloud->size());
+  cloud->height = 1;
+  return cloud;
+}
+
+SelectiveSegmentationParameters
+panoramic()
+{
+  SelectiveSegmentationParameters p;
+  p.projection = ViewProjection::Panoramic;
+  return p;
+}
+
+} // namespace
+
+TEST(PanoramicSegmentation, EveryWallOfARoomIsOneSegmentTheOneBehindTheSeamToo)
+{
+  std::vector<int> face;
+  const auto cloud = scanRoom(face);
+  for (const auto frame : {NormalSpreadFrame::Sensor, NormalSpreadFrame::MeanNormal}) {
+    auto params = panoramic();
+    params.normal_spread_frame = frame;
+    Seg seg;
+    seg.setParameters(params);
+    seg.setInputCloud(cloud);
+    std::vector<pcl::PointIndices> segments;
+    ASSERT_TRUE(seg.extract(segments));
+    EXPECT_TRUE(seg.getTriangulation().seam_closed);
+    const auto& labels = seg.getResult().labels;
+    // Every point has an image; each wall's largest segment holds nearly all of it
+    // and little of another wall. Wall 4 (z = -4 m) lies across the seam.
+    EXPECT_EQ(seg.getResult().counts.behind_sensor, 0u);
+    std::map<int, std::map<std::uint32_t, std::size_t>> per_face;
+    std::map<std::uint32_t, std::map<int, std::size_t>> per_label;
+    for (std::size_t i = 0; i < labels.size(); ++i) {
+      ++per_face[face[i]][labels[i]];
+      ++per_label[labels[i]][face[i]];
+    }
+    ASSERT_EQ(per_face.size(), 6u);
+    for (const auto& [f, counts] : per_face) {
+      std::size_t total = 0, largest = 0;
+      std::uint32_t label = 0;
+      for (const auto& [l, c] : counts) {
+        total += c;
+        if (c > largest && l != 0) {
+          largest = c;
+          label = l;
+        }
+      }
+      EXPECT_GE(largest, 0.95 * total)
+          << "wall " << f << ", frame " << static_cast<int>(frame);
+      std::size_t elsewhere = 0;
+      for (const auto& [g, c] : per_label[label])
+        elsewhere += (g != f) * c;
+      // The points along the room's 90-degree corners, whose normals mix both walls,
+      // go to either wall: 0.9-1.8% of a wall here.
+      EXPECT_LE(elsewhere, 0.025 * largest) << "wall " << f;
+    }
+  }
+}
+
+TEST(PanoramicSegmentation, PointOrderDoesNotMatter)
+{
+  std::vector<int> face;
+  const auto cloud = scanRoom(face, 11);
+  std::vector<int> order(cloud->size());
+  std::iota(order.begin(), order.end(), 0);
+  std::shuffle(order.begin(), order.end(), std::mt19937(3));
+  auto shuffled = pcl::make_shared<Cloud>();
+  for (const int i : order)
+    shuffled->push_back((*cloud)[i]);
+  Seg a, b;
+  a.setParameters(panoramic());
+  b.setParameters(panoramic());
+  a.setInputCloud(cloud);
+  b.setInputCloud(shuffled);
+  std::vector<pcl::PointIndices> sa, sb;
+  ASSERT_TRUE(a.extract(sa));
+  ASSERT_TRUE(b.extract(sb));
+  ASSERT_EQ(sa.size(), sb.size());
+  const auto& la = a.getResult().labels;
+  const auto& lb = b.getResult().labels;
+  for (std::size_t k = 0; k < order.size(); ++k)
+    ASSERT_EQ(la[order[k]], lb[k]) << k;
+}
+
+TEST(PanoramicSegmentation, UpdateRunsFromScratchAndEqualsExtract)
+{
+  std::vector<int> face;
+  const auto cloud = scanRoom(face, 5);
+  const std::size_t half = cloud->size() / 2;
+  auto first = pcl::make_shared<Cloud>(), second = pcl::make_shared<Cloud>();
+  first->points.assign(cloud->begin(), cloud->begin() + half);
+  second->points.assign(cloud->begin() + half, cloud->end());
+  first->width = static_cast<std::uint32_t>(first->size());
+  second->width = static_cast<std::uint32_t>(second->size());
+  first->height = second->height = 1;
+  Seg seg;
+  seg.setParameters(panoramic());
+  seg.setInputCloud(first);
+  std::vector<pcl::PointIndices> segments;
+  ASSERT_TRUE(seg.extract(segments));
+  ASSERT_TRUE(seg.update(*second, segments));
+  EXPECT_FALSE(seg.getUpdateStatistics().incremental);
+  Seg whole;
+  auto params = panoramic();
+  params.min_voxel_size = seg.getResult().min_voxel_size;
+  whole.setParameters(params);
+  whole.setInputCloud(cloud);
+  std::vector<pcl::PointIndices> expected;
+  ASSERT_TRUE(whole.extract(expected));
+  EXPECT_EQ(seg.getResult().labels, whole.getResult().labels);
+}
+
+TEST(PanoramicSegmentation, ForwardOnlyFeaturesAndBadParametersAreRefused)
+{
+  auto p = panoramic();
+  std::string why;
+  EXPECT_TRUE(p.validate(&why)) << why;
+  p.angle_quantization = 5e-8; // the periodic strip would leave the exact range
+  EXPECT_FALSE(p.validate(&why));
+  EXPECT_NE(why.find("panoramic"), std::string::npos) << why;
+  p = panoramic();
+  p.delaunay_backend = DelaunayBackend::Vtk;
+  EXPECT_FALSE(p.validate(&why));
+  p.projection = static_cast<ViewProjection>(7);
+  EXPECT_FALSE(p.validate(&why));
+  EXPECT_NE(why.find("projection"), std::string::npos) << why;
+
+  std::vector<int> face;
+  const auto cloud = scanRoom(face);
+  Seg seg;
+  seg.setParameters(panoramic());
+  seg.setInputCloud(cloud);
+  std::vector<pcl::PointIndices> segments;
+  ASSERT_TRUE(seg.extract(segments));
+  std::vector<RegionOfInterest> regions;
+  EXPECT_FALSE(computeRegionsOfInterest(seg, RegionOfInterestParameters(), regions));
+  EXPECT_TRUE(regions.empty());
+
+  // The forward projection leaves out the half of the room behind the sensor.
+  Seg forward;
+  forward.setInputCloud(cloud);
+  ASSERT_TRUE(forward.extract(segments));
+  EXPECT_GT(forward.getResult().counts.behind_sensor, cloud->size() / 3);
+}
