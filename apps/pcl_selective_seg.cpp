@@ -253,13 +253,6 @@ parseOptions(int argc, char** argv, Options& opt)
   if (!selseg_apps::parseSegmentationOptions(argc, argv, opt.params) ||
       !selseg_apps::parseRegionOptions(argc, argv, opt.roi))
     return kUsageError;
-  if (!opt.roi_json.empty() &&
-      opt.params.projection != pcl::selective_seg::ViewProjection::Forward) {
-    print_error("-roi_json needs the forward projection: regions of interest are "
-                "windows of eq. 1's angles (drop -roi_json or -projection "
-                "panoramic).\n");
-    return kUsageError;
-  }
   return 0;
 }
 
@@ -404,7 +397,8 @@ writeOutputs(const Options& opt,
               return writeSummaryJson(f, info, r, threads);
             }) &&
       write(opt.roi_json, [&](const std::string& f) {
-        return writeRegionsJson(f, opt.input, opt.roi, stats, regions);
+        return writeRegionsJson(
+            f, opt.input, opt.roi, stats, regions, opt.params.projection);
       });
   if (ok && !outputs.commit(error)) {
     print_error("%s\n", error.c_str());

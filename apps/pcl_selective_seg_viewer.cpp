@@ -287,11 +287,6 @@ parseOptions(int argc, char** argv, Options& opt)
     print_error("Give -roi or -roi_json, not both.\n");
     return kUsageError;
   }
-  if (opt.roi && opt.params.projection != pcl::selective_seg::ViewProjection::Forward) {
-    print_error("Regions of interest are windows of the forward projection's angles: "
-                "drop -roi or -projection panoramic.\n");
-    return kUsageError;
-  }
   opt.ignore_viewpoint = find_switch(argc, argv, "-ignore_viewpoint");
   opt.octree_wireframe = find_switch(argc, argv, "-wireframe");
   opt.legend = !find_switch(argc, argv, "-no_legend");
@@ -528,16 +523,22 @@ buildNormals(const Scene& scene, int step)
 }
 
 /** Each region of interest as the outline of its angular window, drawn on a plane in
- * front of the nearest labeled point (so that it is never hidden), coloured by its
+ * front of the nearest labeled point (so that it is never hidden; for a panorama's
+ * windows, on a sphere around the sensor inside the nearest point), coloured by its
  * first reason: yellow transition, magenta small segment, cyan sparse. */
 PolyData
 buildRegions(const Scene& scene)
 {
   const Eigen::Affine3f to_sensor = scene.sensor_pose.inverse();
+  const bool panoramic =
+      !scene.regions.empty() &&
+      scene.regions.front().projection == pcl::selective_seg::ViewProjection::Panoramic;
   float depth = std::numeric_limits<float>::infinity();
   for (std::size_t i = 0; i < scene.cloud->size(); ++i)
-    if (scene.result.labels[i] != 0)
-      depth = std::min(depth, (to_sensor * (*scene.cloud)[i].getVector3fMap()).z());
+    if (scene.result.labels[i] != 0) {
+      const Eigen::Vector3f s = to_sensor * (*scene.cloud)[i].getVector3fMap();
+      depth = std::min(depth, panoramic ? s.norm() : s.z());
+    }
   depth = std::isfinite(depth) ? 0.9f * depth : 1.0f;
   auto points = vtkSmartPointer<vtkPoints>::New();
   auto cells = vtkSmartPointer<vtkCellArray>::New();
@@ -549,8 +550,15 @@ buildRegions(const Scene& scene)
                                   {r.theta_min, r.phi_max}};
     vtkIdType ids[5];
     for (int c = 0; c < 4; ++c) {
-      const Eigen::Vector3f ray(static_cast<float>(std::tan(corners[c][0])),
-                                static_cast<float>(std::tan(corners[c][1])),
+      // Eq. 1's windows on the plane z = depth; a panorama's on the sphere r = depth.
+      const double theta = corners[c][0], phi = corners[c][1];
+      const Eigen::Vector3f ray =
+          r.projection == pcl::selective_seg::ViewProjection::Panoramic
+              ? Eigen::Vector3f(static_cast<float>(std::cos(phi) * std::sin(theta)),
+                                static_cast<float>(std::sin(phi)),
+                                static_cast<float>(std::cos(phi) * std::cos(theta)))
+              : Eigen::Vector3f(static_cast<float>(std::tan(theta)),
+                                static_cast<float>(std::tan(phi)),
                                 1.0f);
       const Eigen::Vector3f p = scene.sensor_pose * (depth * ray);
       ids[c] = points->InsertNextPoint(p.data());

@@ -205,6 +205,7 @@ panoramic()
 {
   SelectiveSegmentationParameters p;
   p.projection = ViewProjection::Panoramic;
+  p.normal_spread_frame = NormalSpreadFrame::MeanNormal;
   return p;
 }
 
@@ -214,9 +215,8 @@ TEST(PanoramicSegmentation, EveryWallOfARoomIsOneSegmentTheOneBehindTheSeamToo)
 {
   std::vector<int> face;
   const auto cloud = scanRoom(face);
-  for (const auto frame : {NormalSpreadFrame::Sensor, NormalSpreadFrame::MeanNormal}) {
-    auto params = panoramic();
-    params.normal_spread_frame = frame;
+  {
+    const auto params = panoramic();
     Seg seg;
     seg.setParameters(params);
     seg.setInputCloud(cloud);
@@ -244,8 +244,7 @@ TEST(PanoramicSegmentation, EveryWallOfARoomIsOneSegmentTheOneBehindTheSeamToo)
           label = l;
         }
       }
-      EXPECT_GE(largest, 0.95 * total)
-          << "wall " << f << ", frame " << static_cast<int>(frame);
+      EXPECT_GE(largest, 0.95 * total) << "wall " << f;
       std::size_t elsewhere = 0;
       for (const auto& [g, c] : per_label[label])
         elsewhere += (g != f) * c;
@@ -309,7 +308,7 @@ TEST(PanoramicSegmentation, UpdateRunsFromScratchAndEqualsExtract)
   EXPECT_EQ(seg.getResult().labels, whole.getResult().labels);
 }
 
-TEST(PanoramicSegmentation, ForwardOnlyFeaturesAndBadParametersAreRefused)
+TEST(PanoramicSegmentation, BadParametersAreRefused)
 {
   auto p = panoramic();
   std::string why;
@@ -320,6 +319,10 @@ TEST(PanoramicSegmentation, ForwardOnlyFeaturesAndBadParametersAreRefused)
   p = panoramic();
   p.delaunay_backend = DelaunayBackend::Vtk;
   EXPECT_FALSE(p.validate(&why));
+  p = panoramic();
+  p.normal_spread_frame = NormalSpreadFrame::Sensor; // ill-conditioned all around
+  EXPECT_FALSE(p.validate(&why));
+  EXPECT_NE(why.find("mean_normal"), std::string::npos) << why;
   p.projection = static_cast<ViewProjection>(7);
   EXPECT_FALSE(p.validate(&why));
   EXPECT_NE(why.find("projection"), std::string::npos) << why;
@@ -331,13 +334,62 @@ TEST(PanoramicSegmentation, ForwardOnlyFeaturesAndBadParametersAreRefused)
   seg.setInputCloud(cloud);
   std::vector<pcl::PointIndices> segments;
   ASSERT_TRUE(seg.extract(segments));
-  std::vector<RegionOfInterest> regions;
-  EXPECT_FALSE(computeRegionsOfInterest(seg, RegionOfInterestParameters(), regions));
-  EXPECT_TRUE(regions.empty());
-
   // The forward projection leaves out the half of the room behind the sensor.
   Seg forward;
   forward.setInputCloud(cloud);
   ASSERT_TRUE(forward.extract(segments));
   EXPECT_GT(forward.getResult().counts.behind_sensor, cloud->size() / 3);
+}
+
+TEST(PanoramicRegions, WindowsOnBothSidesOfTheSeamWithExactSolidAngles)
+{
+  // The room turned about its vertical so that the corner (3, y, -4), at azimuth
+  // atan2(3, -4), lies on the seam at theta = +-pi.
+  std::vector<int> face;
+  const auto room = scanRoom(face, 9);
+  const double turn = M_PI - std::atan2(3.0, -4.0);
+  auto cloud = pcl::make_shared<Cloud>();
+  for (const auto& p : *room)
+    cloud->push_back(pcl::PointXYZ(
+        static_cast<float>(p.x * std::cos(turn) + p.z * std::sin(turn)),
+        p.y,
+        static_cast<float>(-p.x * std::sin(turn) + p.z * std::cos(turn))));
+  Seg seg;
+  seg.setParameters(panoramic());
+  seg.setInputCloud(cloud);
+  std::vector<pcl::PointIndices> segments;
+  ASSERT_TRUE(seg.extract(segments));
+  ASSERT_TRUE(seg.getTriangulation().seam_closed);
+  std::vector<RegionOfInterest> regions;
+  RegionOfInterestStats stats;
+  ASSERT_TRUE(
+      computeRegionsOfInterest(seg, RegionOfInterestParameters(), regions, &stats));
+  std::printf("%zu windows, evidence: %zu transition, %zu small segment, %zu sparse\n",
+              regions.size(),
+              stats.transition_vertices,
+              stats.small_segment_vertices,
+              stats.sparse_vertices);
+  ASSERT_FALSE(regions.empty());
+  bool below_seam = false, above_seam = false;
+  for (const auto& r : regions) {
+    EXPECT_EQ(r.projection, ViewProjection::Panoramic);
+    EXPECT_GE(r.theta_min, -M_PI);
+    EXPECT_LE(r.theta_max, M_PI);
+    EXPECT_LT(r.theta_min, r.theta_max);
+    EXPECT_NEAR(r.solid_angle,
+                (r.theta_max - r.theta_min) *
+                    (std::sin(r.phi_max) - std::sin(r.phi_min)),
+                1e-12);
+    if (r.reasons & kTransition) {
+      below_seam |= r.theta_min < -M_PI + 0.05;
+      above_seam |= r.theta_max > M_PI - 0.05;
+    }
+  }
+  // The corner's evidence, on both sides of the seam.
+  EXPECT_TRUE(below_seam);
+  EXPECT_TRUE(above_seam);
+  // The spacing of a vertex next to the seam is measured the short way round: an
+  // evenly sampled room has no sparse evidence (without it, every vertex along the
+  // seam would be "2 pi" from its neighbours across it).
+  EXPECT_EQ(stats.sparse_vertices, 0u);
 }

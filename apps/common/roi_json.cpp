@@ -76,12 +76,16 @@ writeRegionsJson(const std::string& path,
                  const std::string& input,
                  const pcl::selective_seg::RegionOfInterestParameters& p,
                  const pcl::selective_seg::RegionOfInterestStats& s,
-                 const std::vector<RegionOfInterest>& regions)
+                 const std::vector<RegionOfInterest>& regions,
+                 pcl::selective_seg::ViewProjection projection)
 {
+  const bool panoramic = projection == pcl::selective_seg::ViewProjection::Panoramic;
   std::ofstream out(path);
   out << std::setprecision(9) << "{\n  \"input\": " << jsonString(input)
-      << ",\n  \"frames\": \"windows: sensor frame, theta = atan2(x, z), phi = "
-         "atan2(y, z) [rad]; boxes: cloud frame [m]\",\n"
+      << ",\n  \"projection\": \"" << (panoramic ? "panoramic" : "forward")
+      << "\",\n  \"frames\": \"windows: sensor frame, theta = atan2(x, z), phi = "
+      << (panoramic ? "atan2(y, sqrt(x^2 + z^2))" : "atan2(y, z)")
+      << " [rad]; boxes: cloud frame [m]\",\n"
       << "  \"budget\": {\"max_solid_angle_sr\": " << p.max_solid_angle
       << ", \"max_points\": " << p.max_points << ", \"max_regions\": " << p.max_regions
       << ", \"target_step_rad\": " << p.target_step
@@ -135,11 +139,16 @@ readRegionsJson(const std::string& path,
     return false;
   }
   const std::size_t list_end = text.rfind(']'); // the regions list comes last
+  const std::size_t named = text.find("\"projection\": \"panoramic\"");
+  const auto projection = named != std::string::npos && named < at
+                              ? pcl::selective_seg::ViewProjection::Panoramic
+                              : pcl::selective_seg::ViewProjection::Forward;
   while ((at = text.find('{', at)) != std::string::npos) {
     const std::size_t end = text.find('}', at);
     if (end == std::string::npos || end > list_end)
       break;
     RegionOfInterest r;
+    r.projection = projection;
     double step = 0.0, current = 0.0, priority = 0.0;
     if (!findNumber(text, at, end, "theta_min", r.theta_min) ||
         !findNumber(text, at, end, "theta_max", r.theta_max) ||

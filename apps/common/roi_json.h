@@ -20,10 +20,13 @@ bool writeRegionsJson(const std::string& path,
                       const std::string& input,
                       const pcl::selective_seg::RegionOfInterestParameters& params,
                       const pcl::selective_seg::RegionOfInterestStats& stats,
-                      const std::vector<pcl::selective_seg::RegionOfInterest>& regions);
+                      const std::vector<pcl::selective_seg::RegionOfInterest>& regions,
+                      pcl::selective_seg::ViewProjection projection =
+                          pcl::selective_seg::ViewProjection::Forward);
 
 /** \brief Read the regions back from a file written by writeRegionsJson() (windows,
- * boxes, priority, steps, reasons and counts; other keys are ignored).
+ * boxes, priority, steps, reasons and counts, and the projection: forward when the
+ * file does not name it; other keys are ignored).
  * \param[out] error what is wrong, naming the file */
 bool readRegionsJson(const std::string& path,
                      std::vector<pcl::selective_seg::RegionOfInterest>& regions,

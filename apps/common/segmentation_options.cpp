@@ -205,8 +205,8 @@ printSegmentationHelp()
       "  -backend NAME          Delaunay backend: sweep, boost or vtk (default sweep)\n");
   print_info("  -projection NAME       directions to angles: forward (paper's eq. 1; "
              "points behind the sensor are left out) or panoramic (azimuth and "
-             "elevation, the mesh closed around the sensor: a spinning lidar) (default "
-             "forward)\n");
+             "elevation, the mesh closed around the sensor: a spinning lidar; implies "
+             "-spread_frame mean_normal) (default forward)\n");
   print_info("  -threads N             threads of the parallel stages; 0 = automatic: "
              "OMP_NUM_THREADS, else the CPUs the process may use (default %d; the "
              "result does not depend on it)\n",
@@ -245,6 +245,10 @@ parseSegmentationOptions(int argc, char** argv, SelectiveSegmentationParameters&
                     {"sweep", DelaunayBackend::Sweep}},
                    p.delaunay_backend))
     return false;
+  // The panoramic projection needs eq. 5 in the voxel's frame (validate() says why).
+  if (p.projection == ViewProjection::Panoramic &&
+      pcl::console::find_argument(argc, argv, "-spread_frame") < 0)
+    p.normal_spread_frame = NormalSpreadFrame::MeanNormal;
   std::string why;
   if (!p.validate(&why)) {
     print_error("%s\n", why.c_str());

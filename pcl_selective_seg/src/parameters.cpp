@@ -121,6 +121,15 @@ SelectiveSegmentationParameters::validate(std::string* why) const
                     "angle_quantization [rad]",
                     angle_quantization,
                     "[1e-7, 1e-2] with the panoramic projection");
+    if (normal_spread_frame != NormalSpreadFrame::MeanNormal) {
+      if (why)
+        *why =
+            "parameter normal_spread_frame = sensor cannot go with the panoramic "
+            "projection: eq. 5's sensor-frame angles are ill-conditioned for normals "
+            "perpendicular to the optical axis, which a panorama's walls, floor and "
+            "ceiling have all around; set normal_spread_frame = mean_normal";
+      return false;
+    }
     if (delaunay_backend == DelaunayBackend::Vtk) {
       if (why)
         *why = "parameter delaunay_backend = vtk cannot triangulate the panoramic "

@@ -26,6 +26,23 @@ namespace {
 constexpr double kHalfPi = 0.5 * M_PI;
 /** Windows stay this far inside (-pi/2, pi/2), where eq. 1 has an image. */
 constexpr double kEdgeGuard = 1e-6;
+
+/** The step from b to a in (theta, phi) [rad]; with the panoramic projection theta's
+ * difference is taken the short way round the seam, into (-pi, pi]. */
+Eigen::Vector2d
+angleStep(const Eigen::Vector2d& a,
+          const Eigen::Vector2d& b,
+          const SphericalTriangulation& tri)
+{
+  Eigen::Vector2d d = a - b;
+  if (tri.projection == ViewProjection::Panoramic) {
+    if (d.x() > M_PI)
+      d.x() -= 2.0 * M_PI;
+    else if (d.x() <= -M_PI)
+      d.x() += 2.0 * M_PI;
+  }
+  return d;
+}
 /** Smallest max_window_size: a nanoradian, far below any scan's angular resolution
  * (the finest angle quantization is 2.5e-8 rad). */
 constexpr double kMinWindowSize = 1e-9;
@@ -159,7 +176,7 @@ vertexSpacing(const SphericalTriangulation& tri,
     for (int k = 0; k < 3; ++k) {
       const auto a = t[k];
       const auto b = t[(k + 1) % 3];
-      const double length = (angles[a] - angles[b]).norm();
+      const double length = angleStep(angles[a], angles[b], tri).norm();
       lengths[fill[a]++] = length;
       lengths[fill[b]++] = length;
     }
@@ -414,7 +431,8 @@ findEvidence(const SegmentationResult& result,
         continue;
       const auto a = tri.triangles[t][(k + 1) % 3];
       const auto b = tri.triangles[t][(k + 2) % 3];
-      if ((angles[a] - angles[b]).norm() > 2.0 * std::max(spacing[a], spacing[b]))
+      if (angleStep(angles[a], angles[b], tri).norm() >
+          2.0 * std::max(spacing[a], spacing[b]))
         kinds[a] = kinds[b] = 0;
     }
   // With a fixed target step, evidence already sampled about that finely is spent:
@@ -454,7 +472,8 @@ makeTileWindows(const SphericalTriangulation& tri,
     // Tiles start at the component's smallest angles: a component that fits in one
     // tile gives one window.
     std::vector<std::size_t> size(nv, 0);
-    std::vector<Eigen::Vector2d> start(nv, Eigen::Vector2d::Constant(kHalfPi));
+    std::vector<Eigen::Vector2d> start(
+        nv, Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity()));
     for (std::size_t v = 0; v < nv; ++v)
       if (kinds[v] & kind) {
         const std::size_t root = sets.find(v);
@@ -500,8 +519,11 @@ makeTileWindows(const SphericalTriangulation& tri,
     const double margin = p.margin + p.margin_spacings * median(local);
     const double grow_theta = std::max(margin, 0.5 * (p.min_window_size - w.width()));
     const double grow_phi = std::max(margin, 0.5 * (p.min_window_size - w.height()));
-    w.theta_min = std::max(w.theta_min - grow_theta, -kHalfPi + kEdgeGuard);
-    w.theta_max = std::min(w.theta_max + grow_theta, kHalfPi - kEdgeGuard);
+    // A panorama's azimuth ends at +-pi (the seam), eq. 1's short of +-pi/2.
+    const double theta_limit =
+        tri.projection == ViewProjection::Panoramic ? M_PI : kHalfPi - kEdgeGuard;
+    w.theta_min = std::max(w.theta_min - grow_theta, -theta_limit);
+    w.theta_max = std::min(w.theta_max + grow_theta, theta_limit);
     w.phi_min = std::max(w.phi_min - grow_phi, -kHalfPi + kEdgeGuard);
     w.phi_max = std::min(w.phi_max + grow_phi, kHalfPi - kEdgeGuard);
     if (w.width() > 0.0 && w.height() > 0.0)
@@ -670,8 +692,14 @@ RegionOfInterestParameters::validate(std::string* why) const
 }
 
 double
-windowSolidAngle(double theta_min, double theta_max, double phi_min, double phi_max)
+windowSolidAngle(double theta_min,
+                 double theta_max,
+                 double phi_min,
+                 double phi_max,
+                 ViewProjection projection)
 {
+  if (projection == ViewProjection::Panoramic)
+    return (theta_max - theta_min) * (std::sin(phi_max) - std::sin(phi_min));
   // On the plane z = 1 the window is the rectangle [tan theta] x [tan phi]; the solid
   // angle of [0, u] x [0, v] there is atan(u v / sqrt(1 + u^2 + v^2)).
   const auto corner = [](double u, double v) {
@@ -697,14 +725,6 @@ computeRegionsOfInterest(const SegmentationResult& result,
   std::string why;
   if (!p.validate(&why)) {
     PCL_ERROR("[pcl::selective_seg::computeRegionsOfInterest] %s\n", why.c_str());
-    return false;
-  }
-  if (tri.projection != ViewProjection::Forward) {
-    // The windows are rectangles in eq. 1's (theta, phi) on the plane z = 1 (their
-    // solid angle, the rays of a finer scan): a panorama has no such plane.
-    PCL_ERROR("[pcl::selective_seg::computeRegionsOfInterest] the triangulation uses "
-              "the panoramic projection; regions of interest are defined for the "
-              "forward projection (eq. 1) only\n");
     return false;
   }
   const std::size_t nv = tri.vertex_point.size();
@@ -819,7 +839,9 @@ computeRegionsOfInterest(const SegmentationResult& result,
       continue;
     }
     const double area = w.area();
-    r.solid_angle = windowSolidAngle(r.theta_min, r.theta_max, r.phi_min, r.phi_max);
+    r.solid_angle = windowSolidAngle(
+        r.theta_min, r.theta_max, r.phi_min, r.phi_max, tri.projection);
+    r.projection = tri.projection;
     // Saturated: a tiny target step can ask for more samples than a size_t holds.
     const double estimate =
         std::round(p.sample_yield * area / (r.suggested_step * r.suggested_step));

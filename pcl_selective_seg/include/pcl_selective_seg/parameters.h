@@ -167,8 +167,10 @@ struct PCL_EXPORTS SelectiveSegmentationParameters {
   double angle_quantization = 1e-7;
 
   /** \brief Stage 1's mapping of directions. Default: Forward, the paper's eq. 1.
-   * Panoramic needs an exact backend and angle_quantization >= 1e-7 (the periodic
-   * strip must fit the exact predicates' coordinate range). */
+   * Panoramic needs normal_spread_frame = MeanNormal (eq. 5's sensor-frame angles are
+   * ill-conditioned for the normals perpendicular to the optical axis that a
+   * panorama has all around), an exact backend and angle_quantization >= 1e-7 (the
+   * periodic strip must fit the exact predicates' coordinate range). */
   ViewProjection projection = ViewProjection::Forward;
 
   /** \brief Threads for the parallel stages; 0 = automatic (defaultThreads()). The

@@ -165,8 +165,11 @@ struct PCL_EXPORTS RegionOfInterestParameters {
 
 /** \brief A region of the view worth a finer acquisition. */
 struct RegionOfInterest {
-  /** Angular window in the sensor frame, eq. 1's angles theta = atan2(x, z),
-   * phi = atan2(y, z) [rad]. */
+  /** Angular window in the sensor frame [rad], in the angles of the triangulation's
+   * projection: eq. 1's theta = atan2(x, z), phi = atan2(y, z), or with the panoramic
+   * projection azimuth theta = atan2(x, z) in [-pi, pi] and elevation phi = atan2(y,
+   * sqrt(x^2 + z^2)). A panoramic window does not cross the seam at theta = +-pi:
+   * evidence on both sides gives a window on each side. */
   double theta_min = 0.0;
   double theta_max = 0.0;
   double phi_min = 0.0;
@@ -188,6 +191,8 @@ struct RegionOfInterest {
   std::size_t num_points = 0;   ///< mesh vertices of the scan inside the window
   std::size_t estimated_points = 0; ///< sample_yield x window area / step^2
   double solid_angle = 0.0;         ///< of the window [sr]
+  /** The mapping of theta and phi (the triangulation's). */
+  ViewProjection projection = ViewProjection::Forward;
 };
 
 /** \brief What computeRegionsOfInterest() found. */
@@ -205,10 +210,15 @@ struct RegionOfInterestStats {
   std::size_t selected_points = 0;   ///< sum of estimated_points
 };
 
-/** \brief Solid angle of an angular window of eq. 1's angles [sr] (exact: the window
- * is a rectangle on the plane z = 1). */
+/** \brief Solid angle of an angular window [sr], exact: of eq. 1's angles a rectangle
+ * on the plane z = 1; of the panoramic azimuth and elevation (theta_max - theta_min)
+ * (sin phi_max - sin phi_min). */
 PCL_EXPORTS double
-windowSolidAngle(double theta_min, double theta_max, double phi_min, double phi_max);
+windowSolidAngle(double theta_min,
+                 double theta_max,
+                 double phi_min,
+                 double phi_max,
+                 ViewProjection projection = ViewProjection::Forward);
 
 /** \brief Semi-angle of the cone of confidence of the mean of \a n unit vectors
  * whose sum has length \a resultant (Fisher, 1953): the true mean direction lies
@@ -235,8 +245,8 @@ fisherConfidenceAngle(std::size_t n, double resultant, double confidence);
  * the selected windows; empty on failure \param[out] stats if non-null: counts of
  * evidence and windows \return false (with PCL_ERROR saying why) on invalid parameters
  * or a result that does not belong to the triangulation. An empty scan gives no region.
- * A panoramic triangulation (ViewProjection::Panoramic) is refused: the windows are
- * rectangles of eq. 1's angles.
+ * With a panoramic triangulation the windows are rectangles of azimuth and elevation;
+ * angle steps across the seam are taken the short way round.
  */
 PCL_EXPORTS bool computeRegionsOfInterest(const SegmentationResult& result,
                                           const SphericalTriangulation& triangulation,
