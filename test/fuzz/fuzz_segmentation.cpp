@@ -12,7 +12,10 @@
 // the first three quarters of the points, update() with the rest, must give exactly
 // extract() on the union with the first run's finest voxel
 // (docs/incremental_update.md). With bit 2 set the cloud declares a layout that is not
-// its size; the getters must still give one output point per input point.
+// its size; the getters must still give one output point per input point. With bit 3
+// set (and not every parameter overridden) the projection is panoramic. Every
+// successful run's regions of interest must be computed, inside the projection's
+// range of angles and with a non-negative solid angle.
 //
 // Input layout (all little endian; missing bytes read as zero):
 //   byte 0        point encoding: 0 raw float32 x y z; 1 int8 grid (x/16, y/16,
@@ -23,6 +26,7 @@
 //   then          13 parameter slots of 8 bytes (double, or int in the low 4 bytes)
 //   then          the points
 
+#include <pcl_selective_seg/regions_of_interest.h>
 #include <pcl_selective_seg/selective_segmentation.h>
 
 #include <pcl/console/print.h>
@@ -214,6 +218,8 @@ LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size)
         static_cast<pcl::selective_seg::PointNormalTriangles>((slot[11] >> 24) & 0xff);
     p.delaunay_backend =
         static_cast<pcl::selective_seg::DelaunayBackend>(slot[12] & 0xff);
+    p.projection =
+        static_cast<pcl::selective_seg::ViewProjection>((slot[12] >> 8) & 0xff);
   } else {
     p.edge_triangle_normal =
         static_cast<pcl::selective_seg::EdgeTriangleNormal>(slot[11] & 1);
@@ -225,6 +231,11 @@ LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size)
         static_cast<pcl::selective_seg::PointNormalTriangles>((slot[11] >> 3) & 1);
     if (slot[12] & 1)
       p.delaunay_backend = pcl::selective_seg::DelaunayBackend::BoostVoronoi;
+    // Bit 3: the panoramic projection (with the spread frame it requires).
+    if (slot[12] & 8) {
+      p.projection = pcl::selective_seg::ViewProjection::Panoramic;
+      p.normal_spread_frame = pcl::selective_seg::NormalSpreadFrame::MeanNormal;
+    }
   }
   // The vtk backend is not under test here (third-party floating point code).
   if (p.delaunay_backend == pcl::selective_seg::DelaunayBackend::Vtk)
@@ -340,6 +351,18 @@ LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size)
             static_cast<std::size_t>(mesh.cloud.width) * mesh.cloud.height ==
                 cloud->size(),
         "polygon mesh");
+  std::vector<pcl::selective_seg::RegionOfInterest> regions;
+  check(pcl::selective_seg::computeRegionsOfInterest(
+            r, seg.getTriangulation(), pose, {}, regions),
+        "regions of interest refused a successful result");
+  const double theta_limit =
+      p.projection == pcl::selective_seg::ViewProjection::Panoramic ? M_PI : M_PI / 2;
+  for (const auto& w : regions)
+    check(w.projection == p.projection && w.theta_min >= -theta_limit &&
+              w.theta_min < w.theta_max && w.theta_max <= theta_limit &&
+              w.phi_min >= -M_PI / 2 && w.phi_min < w.phi_max &&
+              w.phi_max <= M_PI / 2 && w.solid_angle >= 0.0,
+          "region of interest window");
   if (check_update)
     checkUpdate(*cloud, p, pose_bytes != 0 ? &pose : nullptr);
   return 0;

@@ -12,6 +12,8 @@
 #include <pcl/io/pcd_io.h>
 #include <pcl/io/ply_io.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
@@ -107,6 +109,10 @@ main(int argc, char** argv)
     std::string update = sparse;
     update[4 + 12 * 8] = 2;
     writeAll(seg_dir / (stem + "_sparse_i16_update"), update);
+    // The panoramic projection (bit 3).
+    std::string panoramic = sparse;
+    panoramic[4 + 12 * 8] = 8;
+    writeAll(seg_dir / (stem + "_sparse_i16_panoramic"), panoramic);
     // Reading: the same small window in every format the tool reads.
     const auto small = window(cloud, cx - 5, cy - 4, 10, 8, 3);
     const auto with_format = [&](char format, const fs::path& file) {
@@ -129,5 +135,27 @@ main(int argc, char** argv)
     writeAll(io_dir / (stem + "_text"), std::string(1, '\2') + text.str());
   }
   fs::remove_all(scratch);
+  // A room seen all around from its middle (x +-3, y +-1.5, z +-4 m; 36 x 10 rays),
+  // with the panoramic projection: the mesh closes across the seam.
+  pcl::PointCloud<pcl::PointXYZ> room;
+  for (int i = 0; i < 36; ++i)
+    for (int j = 0; j < 10; ++j) {
+      const double az =
+          -M_PI + (i + 0.3 + 0.4 * ((i * 7 + j * 3) % 5) / 4.0) * M_PI / 18;
+      const double el = -0.6 + (j + 0.5) * 0.12;
+      const double d[3] = {
+          std::cos(el) * std::sin(az), std::sin(el), std::cos(el) * std::cos(az)};
+      const double half[3] = {3.0, 1.5, 4.0};
+      double t = 1e30;
+      for (int k = 0; k < 3; ++k)
+        if (d[k] != 0.0)
+          t = std::min(t, half[k] / std::abs(d[k]));
+      room.push_back(pcl::PointXYZ(static_cast<float>(t * d[0]),
+                                   static_cast<float>(t * d[1]),
+                                   static_cast<float>(t * d[2])));
+    }
+  std::string room_input = segmentationInput(room, 0);
+  room_input[4 + 12 * 8] = 8;
+  writeAll(seg_dir / "room_panoramic_f32", room_input);
   return 0;
 }
