@@ -197,6 +197,32 @@ TEST_F(Tool, NoUsablePointIsARuntimeError)
   EXPECT_EQ(files(), 0u);
 }
 
+TEST_F(Tool, PanoramicProjectionSegmentsPointsBehindTheSensor)
+{
+  // The same file with the panoramic projection: every point has an image.
+  ASSERT_EQ(run("'" + scan + "' -projection panoramic -o " + out("labels.pcd") +
+                " -json " + out("summary.json") + " -roi_json " + out("rois.json")),
+            0);
+  const std::string summary = fileBytes(out("summary.json"));
+  for (const char* entry : {"\"projection\": \"panoramic\"",
+                            "\"spread_frame\": \"mean_normal\"", // implied
+                            "\"behind_sensor\": 0"})
+    EXPECT_NE(summary.find(entry), std::string::npos) << entry;
+  EXPECT_NE(fileBytes(out("rois.json")).find("\"projection\": \"panoramic\""),
+            std::string::npos);
+  std::vector<pcl::selective_seg::RegionOfInterest> regions;
+  std::string error;
+  ASSERT_TRUE(selseg_apps::readRegionsJson(out("rois.json"), regions, error)) << error;
+  ASSERT_FALSE(regions.empty());
+  for (const auto& r : regions)
+    EXPECT_EQ(r.projection, pcl::selective_seg::ViewProjection::Panoramic);
+  const std::string in = "'" + scan + "' -o " + out("other.pcd");
+  EXPECT_EQ(run(in + " -projection panoramic -spread_frame sensor"), 2);
+  EXPECT_EQ(run(in + " -projection sideways"), 2);
+  EXPECT_EQ(run(in + " -projection panoramic -backend vtk"), 2);
+  EXPECT_FALSE(fs::exists(out("other.pcd")));
+}
+
 TEST_F(Tool, BadOptionsAreUsageErrors)
 {
   const std::string in = "'" + scan + "' -ignore_viewpoint -o " + out("labels.pcd");
@@ -242,7 +268,8 @@ TEST_F(Tool, SummaryRecordsEveryParameter)
                             "\"min_split_points\": 8",
                             "\"max_depth\": 12",
                             "\"angle_step_rad\": 2e-07",
-                            "\"backend\": \"sweep\""})
+                            "\"backend\": \"sweep\"",
+                            "\"projection\": \"forward\""})
     EXPECT_NE(text.find(entry), std::string::npos) << entry;
 }
 
