@@ -20,55 +20,95 @@ namespace {
 using detail::inCircle;
 using detail::setError;
 
-/** The points (ids 0..n-1), then copies shifted by -+ period of those within \a
- * margin of the ends. */
-struct Strip {
-  std::vector<QuantizedPoint> points;
-  /** For copy k (strip id n + k): the id of the point it repeats. */
-  std::vector<index_t> original;
-
-  index_t pointOf(index_t id) const
-  {
-    const auto n = static_cast<index_t>(points.size() - original.size());
-    return id < n ? id : original[id - n];
-  }
-};
-
-void
-makeStrip(const std::vector<QuantizedPoint>& points,
-          std::int32_t period,
-          std::int32_t margin,
-          Strip& strip)
-{
-  const std::int32_t half = period / 2;
-  strip.points = points;
-  strip.original.clear();
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    const QuantizedPoint& p = points[i];
-    // margin <= half: no point is repeated on both sides.
-    if (p[0] < -half + margin) {
-      strip.points.push_back({p[0] + period, p[1]});
-      strip.original.push_back(static_cast<index_t>(i));
-    } else if (p[0] >= half - margin) {
-      strip.points.push_back({p[0] - period, p[1]});
-      strip.original.push_back(static_cast<index_t>(i));
-    }
-  }
-}
-
 bool
 lexicographicallyLess(const QuantizedPoint& a, const QuantizedPoint& b)
 {
   return a[0] < b[0] || (a[0] == b[0] && a[1] < b[1]);
 }
 
-/** The strip's triangles whose smallest corner is a point, not a copy: each triangle
- * of the cylinder once; of those, the triangles over the first \a num_points points
- * (not the sentinels after them). \a kept over point ids, \a unwrapped over strip
- * ids. */
+/** The strip: the points and the sentinels, and copies shifted by -+ period of those
+ * within a margin of the ends. Sorted by (x, y) when the points are (the sweep then
+ * skips its sort). */
+struct Strip {
+  std::vector<QuantizedPoint> points;
+  /** Per strip point: the point it is or repeats (ids of the points, then of the
+   * sentinels after them). */
+  std::vector<index_t> source;
+  /** Per strip point: whether it is a copy. */
+  std::vector<std::uint8_t> copy;
+
+  void clear()
+  {
+    points.clear();
+    source.clear();
+    copy.clear();
+  }
+  void add(const QuantizedPoint& p, index_t from, bool is_copy)
+  {
+    points.push_back(p);
+    source.push_back(from);
+    copy.push_back(is_copy);
+  }
+};
+
+/** \a points (ids from \a first_id) and their copies in \a out: those within \a
+ * margin of the right end shifted left by the period, the points, those within the
+ * margin of the left end shifted right (sorted when \a points are). */
+void
+appendWithCopies(const std::vector<QuantizedPoint>& points,
+                 index_t first_id,
+                 std::int32_t period,
+                 std::int32_t margin,
+                 Strip& out)
+{
+  const std::int32_t half = period / 2;
+  // margin <= half: no point is repeated on both sides.
+  for (std::size_t i = 0; i < points.size(); ++i)
+    if (points[i][0] >= half - margin)
+      out.add({points[i][0] - period, points[i][1]},
+              first_id + static_cast<index_t>(i),
+              true);
+  for (std::size_t i = 0; i < points.size(); ++i)
+    out.add(points[i], first_id + static_cast<index_t>(i), false);
+  for (std::size_t i = 0; i < points.size(); ++i)
+    if (points[i][0] < -half + margin)
+      out.add({points[i][0] + period, points[i][1]},
+              first_id + static_cast<index_t>(i),
+              true);
+}
+
+/** The strip of \a points and \a sentinels (sorted by (x, y)): both with their copies,
+ * merged in (x, y) order. */
+void
+makeStrip(const std::vector<QuantizedPoint>& points,
+          const std::vector<QuantizedPoint>& sentinels,
+          std::int32_t period,
+          std::int32_t margin,
+          Strip& strip)
+{
+  Strip data, guard;
+  appendWithCopies(points, 0, period, margin, data);
+  appendWithCopies(
+      sentinels, static_cast<index_t>(points.size()), period, margin, guard);
+  strip.clear();
+  strip.points.reserve(data.points.size() + guard.points.size());
+  std::size_t i = 0, j = 0;
+  while (i < data.points.size() || j < guard.points.size()) {
+    const bool from_data = j == guard.points.size() ||
+                           (i < data.points.size() &&
+                            lexicographicallyLess(data.points[i], guard.points[j]));
+    const Strip& from = from_data ? data : guard;
+    std::size_t& k = from_data ? i : j;
+    strip.add(from.points[k], from.source[k], from.copy[k]);
+    ++k;
+  }
+}
+
+/** The strip's triangles whose smallest corner is not a copy: each triangle of the
+ * cylinder once; of those, the triangles over the \a num_points points (no sentinel
+ * corner). \a kept over point ids, \a unwrapped over strip ids. */
 void
 keepOneCopy(const Strip& strip,
-            std::size_t num_originals,
             std::size_t num_points,
             const std::vector<Triangle>& strip_triangles,
             std::vector<Triangle>& kept,
@@ -76,15 +116,16 @@ keepOneCopy(const Strip& strip,
 {
   kept.clear();
   unwrapped.clear();
+  kept.reserve(strip_triangles.size());
+  unwrapped.reserve(strip_triangles.size());
   for (const Triangle& t : strip_triangles) {
     index_t smallest = t[0];
     for (int i = 1; i < 3; ++i)
       if (lexicographicallyLess(strip.points[t[i]], strip.points[smallest]))
         smallest = t[i];
-    if (static_cast<std::size_t>(smallest) >= num_originals)
+    if (strip.copy[smallest])
       continue;
-    const Triangle mapped{
-        strip.pointOf(t[0]), strip.pointOf(t[1]), strip.pointOf(t[2])};
+    const Triangle mapped{strip.source[t[0]], strip.source[t[1]], strip.source[t[2]]};
     // A triangle wider than the period (two corners one point: a hull edge from a
     // point to its own copy, where one point rises above all others) is no triangle
     // of the cylinder's mesh.
@@ -283,26 +324,24 @@ delaunay2dPeriodic(const std::vector<QuantizedPoint>& points,
                  std::to_string(kMaxDelaunayCoordinate) + " - period / 64)");
     return false;
   }
-  std::vector<QuantizedPoint> with_sentinels = points;
-  const std::int64_t sentinels = std::min<std::int64_t>(64, period);
-  for (std::int64_t j = 0; j < sentinels; ++j) {
-    const auto x = static_cast<std::int32_t>(-half + j * period / sentinels);
-    with_sentinels.push_back({x, y_min - gap});
-    with_sentinels.push_back({x, y_max + gap});
+  std::vector<QuantizedPoint> sentinels; // in (x, y) order
+  const std::int64_t per_row = std::min<std::int64_t>(64, period);
+  for (std::int64_t j = 0; j < per_row; ++j) {
+    const auto x = static_cast<std::int32_t>(-half + j * period / per_row);
+    sentinels.push_back({x, y_min - gap});
+    sentinels.push_back({x, y_max + gap});
   }
   Strip strip;
-  std::vector<Triangle> strip_triangles, unwrapped;
+  std::vector<Triangle> strip_triangles, unwrapped, scratch;
   for (std::int32_t margin = std::min(half, std::max(1, period / 32));;
        margin = std::min(half, 2 * margin)) {
-    makeStrip(with_sentinels, period, margin, strip);
-    if (!delaunay2d(strip.points, backend, strip_triangles, error))
+    makeStrip(points, sentinels, period, margin, strip);
+    // With the adjacency, the sweep runs on num_threads threads (the adjacency itself
+    // is not needed: the cylinder's is computed below).
+    if (!delaunay2d(
+            strip.points, backend, strip_triangles, scratch, error, num_threads))
       return false;
-    keepOneCopy(strip,
-                with_sentinels.size(),
-                points.size(),
-                strip_triangles,
-                triangles,
-                unwrapped);
+    keepOneCopy(strip, points.size(), strip_triangles, triangles, unwrapped);
     computeTriangleNeighbours(triangles, points.size(), neighbours, num_threads);
     if (!triangles.empty() &&
         closesCylinder(strip, period, margin, triangles, unwrapped, neighbours)) {

@@ -192,16 +192,27 @@ std::pair<std::uint64_t, pcl::index_t>
 SphericalDelaunay<PointT>::projectPanoramic(const Eigen::Vector3d& s,
                                             pcl::index_t index) const
 {
-  const double horizontal = std::hypot(s.x(), s.z());
+  // Squares of floats: no overflow in double.
+  const double horizontal = std::sqrt(s.x() * s.x() + s.z() * s.z());
   if (!(horizontal > 0.0 || s.y() != 0.0))
     return {detail::kExcludedKey, kBehindSensor}; // the sensor's own position
-  const long period = panoramicPeriod(angle_quantization_);
-  long theta = std::lround(std::atan2(s.x(), s.z()) / angle_quantization_);
+  const double step = angle_quantization_;
+  const long period = panoramicPeriod(step);
+  // theta = atan2(x, z) on the quantization grid, through quantizedAngle() (twice as
+  // fast as atan2): behind the sensor atan2(x, z) = +-pi - atan(x / -z), and the
+  // quantized value is +-period / 2 minus that of atan(x / -z).
+  long theta;
+  if (s.z() > 0.0)
+    theta = detail::quantizedAngle(s.x(), s.z(), step);
+  else if (s.z() < 0.0)
+    theta = (s.x() >= 0.0 ? period / 2 : -period / 2) -
+            detail::quantizedAngle(s.x(), -s.z(), step);
+  else
+    theta = std::lround(std::atan2(s.x(), 0.0) / step);
   if (theta >= period / 2) // +pi is -pi
     theta -= period;
-  const long phi = horizontal > 0.0
-                       ? detail::quantizedAngle(s.y(), horizontal, angle_quantization_)
-                       : std::lround(std::atan2(s.y(), 0.0) / angle_quantization_);
+  const long phi = horizontal > 0.0 ? detail::quantizedAngle(s.y(), horizontal, step)
+                                    : std::lround(std::atan2(s.y(), 0.0) / step);
   const QuantizedPoint q{static_cast<std::int32_t>(theta),
                          static_cast<std::int32_t>(phi)};
   return {detail::angleKey(q), index};
