@@ -199,10 +199,19 @@ using CellKey = std::array<std::int64_t, 3>;
 CellKey
 cellKey(const Eigen::Vector3d& position, const Eigen::Vector3d& origin, double size)
 {
+  // Saturated beyond +-2^63 cells (an extent past float's range over a fine voxel),
+  // where converting to an integer would be undefined: such cells share a key.
+  const auto cell = [](double c) {
+    constexpr double kLimit = 9.2e18; // below 2^63
+    const double r = std::floor(c + 0.5);
+    if (!(r > -kLimit))
+      return std::numeric_limits<std::int64_t>::min();
+    if (!(r < kLimit))
+      return std::numeric_limits<std::int64_t>::max();
+    return static_cast<std::int64_t>(r);
+  };
   const Eigen::Vector3d c = (position - origin) / size;
-  return {static_cast<std::int64_t>(std::floor(c.x() + 0.5)),
-          static_cast<std::int64_t>(std::floor(c.y() + 0.5)),
-          static_cast<std::int64_t>(std::floor(c.z() + 0.5))};
+  return {cell(c.x()), cell(c.y()), cell(c.z())};
 }
 
 /** Vertices inside finest-size leaves whose normals spread above the threshold. */
@@ -244,7 +253,8 @@ markLeafEvidence(const SegmentationResult& result,
     return;
   std::sort(cells.begin(), cells.end());
   for (std::size_t v = 0; v < tri.vertex_positions.size(); ++v)
-    if (std::binary_search(
+    if (tri.vertex_positions[v].allFinite() &&
+        std::binary_search(
             cells.begin(),
             cells.end(),
             cellKey(tri.vertex_positions[v].cast<double>(), origin, size)))
@@ -783,12 +793,13 @@ computeRegionsOfInterest(const SegmentationResult& result,
               "invertible (its rotation part is singular)\n");
     return false;
   }
-  for (std::size_t v = 0; v < nv; ++v)
-    if (!tri.vertex_positions[v].allFinite() ||
-        (v > 0 && tri.vertex_angles[v][0] < tri.vertex_angles[v - 1][0])) {
-      PCL_ERROR("[pcl::selective_seg::computeRegionsOfInterest] vertex %zu has a "
-                "non-finite position or is out of theta order (vertices are numbered "
-                "in increasing quantized theta)\n",
+  // A vertex's position may overflow float in the sensor frame (a point near float's
+  // limit, rotated): the segmentation leaves it without a normal, and here it counts
+  // for its angles only (no leaf evidence, no part of a box).
+  for (std::size_t v = 1; v < nv; ++v)
+    if (tri.vertex_angles[v][0] < tri.vertex_angles[v - 1][0]) {
+      PCL_ERROR("[pcl::selective_seg::computeRegionsOfInterest] vertex %zu is out of "
+                "theta order (vertices are numbered in increasing quantized theta)\n",
                 v);
       return false;
     }
@@ -862,11 +873,13 @@ computeRegionsOfInterest(const SegmentationResult& result,
       if ((*it)[1] * q < r.phi_min || (*it)[1] * q > r.phi_max)
         continue;
       const auto v = static_cast<std::size_t>(it - tri.vertex_angles.begin());
+      ++r.num_points;
       const Eigen::Vector3f x =
           (to_cloud * tri.vertex_positions[v].cast<double>()).cast<float>();
+      if (!x.allFinite())
+        continue;
       r.box_min = r.box_min.cwiseMin(x);
       r.box_max = r.box_max.cwiseMax(x);
-      ++r.num_points;
     }
     // The weighted share of the window's area its evidence stands for (each vertex
     // spacing^2), times the share of new samples a scan at the suggested step brings.
