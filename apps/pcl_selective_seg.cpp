@@ -308,7 +308,8 @@ printTimings(const pcl::selective_seg::SegmentationResult& r)
 
 void
 printSummary(const pcl::selective_seg::SegmentationResult& r,
-             pcl::selective_seg::ViewProjection projection)
+             pcl::selective_seg::ViewProjection projection,
+             bool seam_closed)
 {
   const bool panoramic = projection == pcl::selective_seg::ViewProjection::Panoramic;
   const auto& c = r.counts;
@@ -329,6 +330,11 @@ printSummary(const pcl::selective_seg::SegmentationResult& r,
              c.behind_sensor,
              panoramic ? "at the sensor's position" : "behind the sensor",
              c.without_normal);
+  if (panoramic)
+    print_info("Mesh: %s\n",
+               seam_closed ? "closed around the sensor"
+                           : "open at the seam theta = +-pi (the points leave a gap of "
+                             "half a turn or more, or are too few around it to close)");
   if (!panoramic && c.behind_sensor >= c.labeled / 10 && c.behind_sensor > 0)
     print_info("%zu points lie behind the sensor and are left unlabeled: for a sensor "
                "that sees all around (a spinning lidar), use -projection panoramic.\n",
@@ -347,7 +353,8 @@ writeOutputs(const Options& opt,
   const RunInfo info{opt.input,
                      cloud.size(),
                      pcl::selective_seg::toString(opt.params.delaunay_backend),
-                     opt.params};
+                     opt.params,
+                     seg.getTriangulation().seam_closed};
   OutputTransaction outputs;
   const auto write = [&](const std::string& path, const auto& writer) {
     if (path.empty() || writer(outputs.stage(path)))
@@ -439,15 +446,22 @@ segment(const Options& opt)
   if (!seg.extract(segments)) {
     const auto& c = seg.getResult().counts;
     if (c.behind_sensor > 0 && c.behind_sensor + c.non_finite == cloud->size())
-      print_error("Every point lies behind the sensor pose; if the cloud is in the "
-                  "camera frame (z forward), pass -ignore_viewpoint.\n");
+      print_error(
+          opt.params.projection == pcl::selective_seg::ViewProjection::Panoramic
+              ? "Every point lies at the sensor's position; check the sensor "
+                "origin (-sensor_origin, the file's VIEWPOINT).\n"
+              : "Every point lies behind the sensor pose; if the cloud is in the "
+                "camera frame (z forward), pass -ignore_viewpoint, or for a "
+                "sensor that sees all around -projection panoramic.\n");
     print_error("Segmentation failed (reason above).\n");
     return kRuntimeError;
   }
   // The outputs come from the result: the point lists are freed for the writers.
   std::vector<pcl::PointIndices>().swap(segments);
   printTimings(seg.getResult());
-  printSummary(seg.getResult(), seg.getParameters().projection);
+  printSummary(seg.getResult(),
+               seg.getParameters().projection,
+               seg.getTriangulation().seam_closed);
   timer.tic();
   if (!writeOutputs(opt, *cloud, seg, pose))
     return kRuntimeError;

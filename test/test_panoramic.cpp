@@ -143,6 +143,88 @@ TEST(Delaunay2dPeriodic, EveryTriangleIsDelaunayOnTheCylinderAndTheMeshCloses)
   }
 }
 
+namespace {
+
+/** When \a closed: every triangle narrower than half the period and Delaunay on the
+ * cylinder (its circle empty of every point and its copies one period either way). */
+void
+expectDelaunayOnTheCylinder(const std::vector<QuantizedPoint>& points,
+                            std::int32_t period,
+                            const std::vector<Triangle>& triangles,
+                            const std::string& what)
+{
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    const auto c = unwrap(points, triangles[t], period);
+    EXPECT_LT(std::max({c[0][0], c[1][0], c[2][0]}) -
+                  std::min({c[0][0], c[1][0], c[2][0]}),
+              period / 2)
+        << what << ", triangle " << t;
+    for (std::size_t p = 0; p < points.size(); ++p)
+      for (const std::int64_t shift : {-period, 0, period}) {
+        const std::array<std::int64_t, 2> d{points[p][0] + shift, points[p][1]};
+        ASSERT_LE(inCircle(c[0], c[1], c[2], d), 0)
+            << what << ", triangle " << t << ", point " << p;
+      }
+  }
+}
+
+} // namespace
+
+// Found by review (session 24): the checks near the seam were local only, and a mesh of
+// a few points spread over more than half a period matched two different edges of the
+// cylinder by their ids. Closed now means Delaunay on the cylinder, or the result is
+// the open planar triangulation.
+TEST(Delaunay2dPeriodic, ClosedMeansDelaunayOnTheCylinderForSparseAndTallInputs)
+{
+  std::vector<Triangle> triangles, neighbours;
+  bool closed = false;
+  const std::vector<QuantizedPoint> sparse{{-19, 105},
+                                           {203, 107},
+                                           {-242, 140},
+                                           {39, 92},
+                                           {236, 82},
+                                           {-95, -10},
+                                           {249, -99},
+                                           {-237, -20},
+                                           {86, -31},
+                                           {-314, 51},
+                                           {-123, 135},
+                                           {-296, 117},
+                                           {-204, 53},
+                                           {-311, -148}};
+  ASSERT_TRUE(delaunay2dPeriodic(
+      sparse, 628, DelaunayBackend::Sweep, triangles, neighbours, closed));
+  if (closed)
+    expectDelaunayOnTheCylinder(sparse, 628, triangles, "sparse");
+  const std::vector<QuantizedPoint> tall{{-5, 26}, {0, 24}, {-6, 33}, {-6, 10}};
+  ASSERT_TRUE(delaunay2dPeriodic(
+      tall, 14, DelaunayBackend::Sweep, triangles, neighbours, closed));
+  EXPECT_FALSE(closed);
+  // Random small and sparse inputs, tall ones among them.
+  std::mt19937 rng(17);
+  std::size_t num_closed = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    const std::int32_t period =
+        2 * std::uniform_int_distribution<std::int32_t>(2, 500)(rng);
+    const std::int32_t height =
+        std::uniform_int_distribution<std::int32_t>(1, 3 * period)(rng);
+    const std::size_t n = std::uniform_int_distribution<std::size_t>(3, 60)(rng);
+    if (static_cast<std::int64_t>(period) * (height + 1) <
+        static_cast<std::int64_t>(2 * n))
+      continue;
+    const auto points = randomCylinderPoints(n, period, height, rng());
+    ASSERT_TRUE(delaunay2dPeriodic(
+        points, period, DelaunayBackend::Sweep, triangles, neighbours, closed));
+    if (!closed)
+      continue;
+    ++num_closed;
+    expectDelaunayOnTheCylinder(
+        points, period, triangles, "trial " + std::to_string(trial));
+  }
+  std::printf("%zu of the random inputs closed\n", num_closed);
+  EXPECT_GT(num_closed, 0u);
+}
+
 TEST(Delaunay2dPeriodic, RefusesBadInput)
 {
   std::vector<Triangle> triangles, neighbours;
@@ -155,6 +237,15 @@ TEST(Delaunay2dPeriodic, RefusesBadInput)
   EXPECT_FALSE(delaunay2dPeriodic(
       points, 16, DelaunayBackend::Sweep, triangles, neighbours, closed, &why));
   EXPECT_NE(why.find("outside"), std::string::npos) << why;
+  // Duplicates are named by their input ids (not by the strip's).
+  EXPECT_FALSE(delaunay2dPeriodic({{0, 0}, {100, 10}, {-50, 30}, {200, 40}, {100, 10}},
+                                  1000,
+                                  DelaunayBackend::Sweep,
+                                  triangles,
+                                  neighbours,
+                                  closed,
+                                  &why));
+  EXPECT_NE(why.find("points 1 and 4 at (100, 10)"), std::string::npos) << why;
   EXPECT_FALSE(closed);
   // Fewer than three points, or a few points far apart: no closed mesh, no failure.
   EXPECT_TRUE(delaunay2dPeriodic(

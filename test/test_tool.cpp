@@ -206,7 +206,9 @@ TEST_F(Tool, PanoramicProjectionSegmentsPointsBehindTheSensor)
   const std::string summary = fileBytes(out("summary.json"));
   for (const char* entry : {"\"projection\": \"panoramic\"",
                             "\"spread_frame\": \"mean_normal\"", // implied
-                            "\"behind_sensor\": 0"})
+                            "\"behind_sensor\": 0",
+                            // a forward view's narrow band of azimuths: left open
+                            "\"seam_closed\": false"})
     EXPECT_NE(summary.find(entry), std::string::npos) << entry;
   EXPECT_NE(fileBytes(out("rois.json")).find("\"projection\": \"panoramic\""),
             std::string::npos);

@@ -685,6 +685,10 @@ writeSummaryJson(const std::string& path,
       << ", \"vertices\": " << r.num_vertices
       << ", \"triangles\": " << r.mesh.triangles.size()
       << ", \"leaves\": " << r.leaves.size() << ", \"segments\": " << r.segments.size()
+      << (p.projection == pcl::selective_seg::ViewProjection::Panoramic
+              ? (info.seam_closed ? ", \"seam_closed\": true"
+                                  : ", \"seam_closed\": false")
+              : "")
       << "},\n  \"median_spacing_m\": " << r.median_spacing
       << ",\n  \"timings_s\": {\"delaunay\": " << t.delaunay
       << ", \"normals\": " << t.normals << ", \"octree\": " << t.octree

@@ -113,6 +113,9 @@ struct RunInfo {
   std::size_t num_points = 0;
   std::string backend;
   pcl::selective_seg::SelectiveSegmentationParameters parameters;
+  /** With the panoramic projection: whether the mesh closed around the sensor
+   * (SphericalTriangulation::seam_closed), written as counts.seam_closed. */
+  bool seam_closed = false;
 };
 
 /** \brief A JSON summary: input, parameters, counts, timings and every segment's size,

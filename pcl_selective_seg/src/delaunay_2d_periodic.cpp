@@ -200,16 +200,72 @@ boundaryWindsAround(const Strip& strip,
   return forward <= 1 && backward <= 1;
 }
 
+/** Whether strip triangle \a t is a triangle of the cylinder for certain: narrower
+ * than half the period (so that each of its edges is one edge of the cylinder), and
+ * the part of its circle inside the band [y_low, y_high], where every point and
+ * sentinel lies, within the strip's x range. The strip holds every copy of a point in
+ * that range and the circle is empty of the strip's points (a Delaunay triangle of the
+ * strip), so it is empty of every point on the cylinder. Computed from exact integer
+ * determinants, compared with a margin of a few steps and of 1e-9 of the radius (far
+ * above the rounding): a borderline triangle only makes the margin grow. */
+bool
+withinStrip(const Strip& strip,
+            const Triangle& t,
+            std::int32_t period,
+            std::int32_t margin,
+            std::int32_t y_low,
+            std::int32_t y_high)
+{
+  const QuantizedPoint &a = strip.points[t[0]], &b = strip.points[t[1]],
+                       &c = strip.points[t[2]];
+  const std::int32_t x_min = std::min({a[0], b[0], c[0]});
+  const std::int32_t x_max = std::max({a[0], b[0], c[0]});
+  if (std::int64_t{x_max} - x_min >= period / 2)
+    return false;
+  // Circumcentre relative to a: (u, v) = (num_u, num_v) / d.
+  const std::int64_t bx = std::int64_t{b[0]} - a[0], by = std::int64_t{b[1]} - a[1];
+  const std::int64_t cx = std::int64_t{c[0]} - a[0], cy = std::int64_t{c[1]} - a[1];
+  const std::int64_t d = 2 * (bx * cy - by * cx);
+  if (d <= 0)
+    return false;
+  const detail::Int128 b2 = detail::Int128{bx} * bx + detail::Int128{by} * by;
+  const detail::Int128 c2 = detail::Int128{cx} * cx + detail::Int128{cy} * cy;
+  using Real = double;
+  const Real u = static_cast<Real>(b2 * cy - c2 * by) / d;
+  const Real v = static_cast<Real>(c2 * bx - b2 * cx) / d;
+  const Real radius = std::sqrt(u * u + v * v);
+  const Real centre_x = a[0] + u, centre_y = a[1] + v;
+  // Half the width of the circle's part in the band.
+  Real half_width = radius;
+  const Real off = centre_y < y_low    ? y_low - centre_y
+                   : centre_y > y_high ? centre_y - y_high
+                                       : Real(0);
+  if (off > 0) {
+    if (off >= radius)
+      return true; // the circle misses the band: no point can be in it
+    half_width = std::sqrt((radius - off) * (radius + off));
+  }
+  const Real slack = 4 + radius * Real(1e-9);
+  const Real half = period / 2;
+  return centre_x - half_width - slack > -half - margin &&
+         centre_x + half_width + slack < half + margin;
+}
+
 /** Whether the kept triangles triangulate the cylinder (delaunay2dPeriodic()'s tests).
  * \a neighbours: their adjacency. */
 bool
 closesCylinder(const Strip& strip,
                std::int32_t period,
                std::int32_t margin,
+               std::int32_t y_low,
+               std::int32_t y_high,
                const std::vector<Triangle>& kept,
                const std::vector<Triangle>& unwrapped,
                const std::vector<Triangle>& neighbours)
 {
+  for (const Triangle& t : unwrapped)
+    if (!withinStrip(strip, t, period, margin, y_low, y_high))
+      return false;
   if (!boundaryWindsAround(strip, period, kept, unwrapped, neighbours))
     return false;
   // Away from the seam the kept triangles are the strip's, a planar triangulation.
@@ -303,6 +359,32 @@ delaunay2dPeriodic(const std::vector<QuantizedPoint>& points,
                    std::to_string(-half) + ", " + std::to_string(half) + ")");
       return false;
     }
+  // Duplicates, named by their ids in the input (the strip's would mislead).
+  // (Sorted already when they are the vertices of SphericalDelaunay.)
+  std::vector<QuantizedPoint> sorted_copy;
+  const bool in_order =
+      std::is_sorted(points.begin(), points.end(), lexicographicallyLess);
+  if (!in_order) {
+    sorted_copy = points;
+    std::sort(sorted_copy.begin(), sorted_copy.end(), lexicographicallyLess);
+  }
+  const std::vector<QuantizedPoint>& sorted_points = in_order ? points : sorted_copy;
+  const auto duplicate = std::adjacent_find(sorted_points.begin(), sorted_points.end());
+  if (duplicate != sorted_points.end()) {
+    detail::reportDuplicate(points, *duplicate, error);
+    return false;
+  }
+  // The widest gap between neighbouring x around the cylinder: a triangle across it is
+  // at least that wide, and one as wide as half the period cannot be told from its
+  // copy (withinStrip()), so the cylinder cannot close; the margin starts beyond it.
+  std::int64_t widest_gap = period; // fewer than two points: nothing to close
+  if (sorted_points.size() > 1) {
+    widest_gap =
+        std::int64_t{sorted_points.front()[0]} + period - sorted_points.back()[0];
+    for (std::size_t k = 1; k < sorted_points.size(); ++k)
+      widest_gap = std::max<std::int64_t>(
+          widest_gap, std::int64_t{sorted_points[k][0]} - sorted_points[k - 1][0]);
+  }
   // Two rows of sentinels, periodic, a sixty-fourth of the period below and above the
   // points: the strip's hull is theirs, so the points' own lower and upper hulls (rows
   // of nearly equal y, whose triangles have circles far wider than any margin) never
@@ -333,7 +415,9 @@ delaunay2dPeriodic(const std::vector<QuantizedPoint>& points,
   }
   Strip strip;
   std::vector<Triangle> strip_triangles, unwrapped, scratch;
-  for (std::int32_t margin = std::min(half, std::max(1, period / 32));;
+  const std::int32_t first_margin = static_cast<std::int32_t>(std::min<std::int64_t>(
+      half, std::max<std::int64_t>({1, period / 32, 2 * widest_gap})));
+  for (std::int32_t margin = first_margin; widest_gap < half;
        margin = std::min(half, 2 * margin)) {
     makeStrip(points, sentinels, period, margin, strip);
     // With the adjacency, the sweep runs on num_threads threads (the adjacency itself
@@ -343,8 +427,14 @@ delaunay2dPeriodic(const std::vector<QuantizedPoint>& points,
       return false;
     keepOneCopy(strip, points.size(), strip_triangles, triangles, unwrapped);
     computeTriangleNeighbours(triangles, points.size(), neighbours, num_threads);
-    if (!triangles.empty() &&
-        closesCylinder(strip, period, margin, triangles, unwrapped, neighbours)) {
+    if (!triangles.empty() && closesCylinder(strip,
+                                             period,
+                                             margin,
+                                             y_min - gap,
+                                             y_max + gap,
+                                             triangles,
+                                             unwrapped,
+                                             neighbours)) {
       closed = true;
       detail::canonicalize(
           triangles, points.size(), &neighbours, static_cast<int>(num_threads));

@@ -121,19 +121,24 @@ PCL_EXPORTS bool delaunay2d(const std::vector<QuantizedPoint>& points,
  * themselves, and named over their ids. The sentinels stand in for the points' own
  * lower and upper hulls, rows of nearly equal y whose slivers have circles far wider
  * than any margin: the mesh ends where the points end, without those slivers, and a
- * point that only a sentinel's triangles reach has no triangle. Every kept triangle is
- * a Delaunay triangle of the points on the cylinder (its circle is empty of the
- * points and the sentinels). The margin starts at period / 32 and doubles, up to period
- * / 2, until the kept triangles close the cylinder: every point a corner, no directed
- * edge used twice, every boundary loop winding once around the cylinder (the lower and
- * upper hulls; a seam left open or a hole makes a loop that does not), and every
- * triangle near the seam Delaunay against its neighbours (the exact in-circle test, a
- * neighbour's corner shifted by the period where the triangles meet across the seam).
- * A triangle wider than the period (two of its corners one point: where one point
- * rises above all others, the hull runs from it to its own copy) is left out. Inside
- * the strip the triangulation is delaunay2d()'s, co-circular points included: the
- * canonical fan rule depends on coordinate differences only, so it splits a group the
- * same way on both sides of the seam.
+ * point that only a sentinel's triangles reach (an outlier at the top or bottom) has
+ * no triangle. When \a closed, every triangle is a Delaunay triangle of the points on
+ * the cylinder: its circle is empty of the points, their copies and the sentinels. The
+ * margin starts at period / 32 and doubles, up to period / 2 (from twice the widest gap
+ * between the points' x, when larger), until the kept triangles close the cylinder for
+ * certain: every triangle narrower than half the period (so that its edges are edges of
+ * the cylinder, not of a copy) and the part of its circle between the sentinel rows
+ * inside the strip (the strip holds every copy there, so the circle is empty on the
+ * cylinder: computed from exact determinants, with a slack); no directed edge used
+ * twice; every boundary loop winding once around the cylinder (a seam left open or a
+ * hole makes a loop that does not); and every triangle near the seam Delaunay against
+ * its neighbours (exact in-circle tests). A gap of half the period or more between
+ * neighbouring x cannot be closed: the result is then the planar one at once. A
+ * triangle wider than the period (two of its corners one point: where one point rises
+ * above all others, the hull runs from it to its own copy) is left out. Inside the
+ * strip the triangulation is delaunay2d()'s, co-circular points included: the canonical
+ * fan rule depends on coordinate differences only, so it splits a group the same way on
+ * both sides of the seam.
  *
  * \param[in] points distinct points with x in [-period / 2, period / 2), |y| <=
  *            kMaxDelaunayCoordinate - period / 64
@@ -143,9 +148,10 @@ PCL_EXPORTS bool delaunay2d(const std::vector<QuantizedPoint>& points,
  * \param[out] neighbours the adjacency (computeTriangleNeighbours()), -1 only along
  *             the open ends of the cylinder (the smallest and largest y)
  * \param[out] closed whether the triangulation closes around the cylinder. When no
- *             margin up to period / 2 gives a closed triangulation (a few points
- *             farther apart than a quarter period), the result is delaunay2d() of
- *             the points in the plane, open at the seam, and \a closed is false.
+ *             margin up to period / 2 gives a closed triangulation (points too few
+ *             or too far apart for it, a gap of half the period, a spread in y
+ *             that no margin covers), the result is delaunay2d() of the points in
+ *             the plane, open at the seam, and \a closed is false.
  * \param[out] error the reason for a failure (may be null)
  * \param[in] num_threads threads of the adjacency (the result does not depend on it)
  * \return false on a precondition violation (range, duplicates, period, backend). */

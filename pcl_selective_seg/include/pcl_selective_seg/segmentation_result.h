@@ -47,7 +47,10 @@ struct PointCounts {
   std::size_t outside_indices = 0; ///< not listed in the indices (label 0)
   std::size_t non_finite = 0;      ///< NaN or Inf coordinate (label 0)
   std::size_t behind_sensor = 0;   ///< z <= 0 in the sensor frame: no image (label 0)
-  std::size_t without_normal = 0;  ///< only degenerate triangles around it (label 0)
+  /** No triangle, or only degenerate ones, around it (label 0). Without a triangle:
+   * with the panoramic projection, an outlying point at the top or bottom of the view
+   * (delaunay2dPeriodic()). */
+  std::size_t without_normal = 0;
   std::size_t labeled = 0;         ///< given a segment label > 0
   std::size_t shared_vertex = 0;   ///< of the labeled: same quantized angles as another
                                    ///< point, so they share that mesh vertex and label
