@@ -138,11 +138,12 @@ public:
   void setAngleQuantization(double step) { angle_quantization_ = step; }
   double getAngleQuantization() const { return angle_quantization_; }
 
-  /** \brief Threads for the projection (0: defaultThreads()). The result does not
-   * depend on it. */
+  /** \brief Threads for the projection and the triangulation (0: defaultThreads();
+   * at most 1024, as SelectiveSegmentationParameters::num_threads: libgomp fails on
+   * teams of tens of thousands). The result does not depend on it. */
   void setNumberOfThreads(unsigned int threads)
   {
-    num_threads_ = threads ? threads : defaultThreads();
+    num_threads_ = threads ? std::min(threads, 1024u) : defaultThreads();
   }
 
   /** \brief Sensor pose in the cloud frame, overriding the cloud's sensor_origin_ /
