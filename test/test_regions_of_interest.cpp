@@ -149,6 +149,17 @@ TEST(RegionsOfInterest, SolidAngleOfAWindow)
               windowSolidAngle(0.1, 0.2, 0.2, 0.5) +
                   windowSolidAngle(0.2, 0.3, 0.2, 0.5),
               1e-12);
+  // Tiny windows (found by review, session 24: the four corner terms cancelled, and a
+  // 1e-9 rad window came out negative). Off the axis, at (1, 1) rad, the density of
+  // solid angle per (theta, phi) area is sec^2 theta sec^2 phi / (1 + tan^2 theta +
+  // tan^2 phi)^(3/2); a window of side s holds s^2 times it, to within s^2 relative.
+  const double t = std::tan(1.0), sec2 = 1.0 + t * t;
+  const double density = sec2 * sec2 / std::pow(1.0 + 2.0 * t * t, 1.5);
+  for (const double side : {1e-9, 2.5e-8, 1e-7, 1e-6, 0.99e-4, 1.01e-4, 1e-3}) {
+    const double width = (1.0 + side) - 1.0; // the side as the window holds it
+    const double omega = windowSolidAngle(1.0, 1.0 + side, 1.0, 1.0 + side);
+    EXPECT_NEAR(omega / (width * width * density), 1.0, 1e-8 + 20.0 * side) << side;
+  }
 }
 
 TEST(RegionsOfInterest, ParametersNameTheBadOne)
@@ -927,6 +938,47 @@ TEST_F(CubeRegions, ShuffledCloudGivesTheSameWindows)
     EXPECT_EQ(a[i].priority, b[i].priority);
     EXPECT_EQ(a[i].estimated_points, b[i].estimated_points);
   }
+}
+
+// Found by review (session 24): the template overload read the cloud's own pose after
+// setSensorPose() had overridden it (boxes in the wrong frame), and a result paired
+// with the triangulation of a shuffled copy of its cloud was accepted.
+TEST_F(CubeRegions, OverloadUsesTheRunsPoseAndAForeignResultIsRefused)
+{
+  Eigen::Affine3f pose = Eigen::Affine3f::Identity();
+  pose.translate(Eigen::Vector3f(1.0f, -2.0f, 0.5f));
+  pose.rotate(Eigen::AngleAxisf(0.7f, Eigen::Vector3f(0.3f, 1.0f, -0.2f).normalized()));
+  auto moved = pcl::make_shared<pcl::PointCloud<pcl::PointXYZL>>();
+  pcl::transformPointCloud(*cloud_, *moved, pose);
+  SelectiveSegmentation<pcl::PointXYZL> seg;
+  seg.setInputCloud(moved); // its own sensor_origin_ and orientation: the identity
+  seg.setSensorPose(pose);
+  std::vector<pcl::PointIndices> clusters;
+  ASSERT_TRUE(seg.extract(clusters));
+  EXPECT_TRUE(seg.getSensorPose().isApprox(pose));
+  std::vector<RegionOfInterest> by_overload, explicit_pose;
+  ASSERT_TRUE(computeRegionsOfInterest(seg, noBudget(), by_overload));
+  ASSERT_TRUE(computeRegionsOfInterest(
+      seg.getResult(), seg.getTriangulation(), pose, noBudget(), explicit_pose));
+  ASSERT_EQ(by_overload.size(), explicit_pose.size());
+  for (std::size_t i = 0; i < by_overload.size(); ++i) {
+    EXPECT_EQ(by_overload[i].theta_min, explicit_pose[i].theta_min);
+    EXPECT_EQ(by_overload[i].box_min, explicit_pose[i].box_min);
+    EXPECT_EQ(by_overload[i].box_max, explicit_pose[i].box_max);
+  }
+
+  auto shuffled = pcl::make_shared<pcl::PointCloud<pcl::PointXYZL>>(*cloud_);
+  std::shuffle(shuffled->points.begin(), shuffled->points.end(), std::mt19937(9));
+  SelectiveSegmentation<pcl::PointXYZL> other;
+  other.setInputCloud(shuffled);
+  ASSERT_TRUE(other.extract(clusters));
+  std::vector<RegionOfInterest> regions;
+  EXPECT_FALSE(computeRegionsOfInterest(seg_->getResult(),
+                                        other.getTriangulation(),
+                                        Eigen::Affine3f::Identity(),
+                                        noBudget(),
+                                        regions));
+  EXPECT_TRUE(regions.empty());
 }
 
 // A refined region proposes no window again.

@@ -17,6 +17,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -153,6 +154,13 @@ TEST_F(ToolRegions, BadBudgetIsAUsageErrorWithNoOutput)
             2);
   EXPECT_EQ(
       run(out("cube.pcd") + " -roi_json " + out("rois.json") + " -roi_weights 1,2"), 2);
+  // Each weight a whole finite number (found by review, session 24: "a,b,c,d,e" was
+  // read as five zeros, and "1,1,1,1," as five numbers).
+  for (const char* bad : {"a,b,c,d,e", "1,1,1,1,", "1,1,1,1,1x", "1,1,1,1,nan"})
+    EXPECT_EQ(run(out("cube.pcd") + " -roi_json " + out("rois.json") +
+                  " -roi_weights " + bad),
+              2)
+        << bad;
   EXPECT_EQ(
       run(out("cube.pcd") + " -roi_json " + out("rois.json") + " -roi_side_points 2.5"),
       2);
@@ -213,6 +221,25 @@ TEST(RegionsJson, ReadsBackWhatWasWritten)
     EXPECT_EQ(read[i].box_max, written[i].box_max);
   }
   EXPECT_EQ(read[0].suggested_step, 0.002);
+  // Found by review (session 24): the projection was recognized in the writer's own
+  // spacing only, and a cut or garbage file read as fewer regions or none.
+  const std::string whole = [&] {
+    std::ifstream in(path);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  }();
+  std::ofstream(path) << "{\"projection\":\"panoramic\",\"regions\":[{\"theta_min\":"
+                         "3,\"theta_max\":3.1,\"phi_min\":0,\"phi_max\":0.1}]}";
+  ASSERT_TRUE(selseg_apps::readRegionsJson(path, read, error)) << error;
+  ASSERT_EQ(read.size(), 1u);
+  EXPECT_EQ(read[0].projection, pcl::selective_seg::ViewProjection::Panoramic);
+  for (const std::string& bad : {whole.substr(0, whole.size() / 2),
+                                 std::string("not json at all \"regions\": nonsense"),
+                                 std::string("{\"projection\": \"sideways\", "
+                                             "\"regions\": []}")}) {
+    std::ofstream(path) << bad;
+    EXPECT_FALSE(selseg_apps::readRegionsJson(path, read, error)) << bad;
+    EXPECT_TRUE(read.empty());
+  }
   // A window with theta_min >= theta_max is an error naming the file and the region.
   std::ofstream(path) << "{\"regions\": [{\"theta_min\": 1, \"theta_max\": 0, "
                          "\"phi_min\": 0, \"phi_max\": 1}]}";

@@ -139,10 +139,30 @@ readRegionsJson(const std::string& path,
     return false;
   }
   const std::size_t list_end = text.rfind(']'); // the regions list comes last
-  const std::size_t named = text.find("\"projection\": \"panoramic\"");
-  const auto projection = named != std::string::npos && named < at
-                              ? pcl::selective_seg::ViewProjection::Panoramic
-                              : pcl::selective_seg::ViewProjection::Forward;
+  // A whole file ends with the list and the object: "] }" (a cut one does not).
+  const std::size_t last = text.find_last_not_of(" \t\r\n");
+  if (list_end == std::string::npos || list_end < at || last == std::string::npos ||
+      text[last] != '}' || text.find_first_not_of(" \t\r\n", list_end + 1) != last) {
+    error = "'" + path + "' ends before its \"regions\" list does (a cut or damaged " +
+            "file; write it again with -roi_json).";
+    return false;
+  }
+  // "projection": "panoramic", with any spacing (written by any JSON tool).
+  auto projection = pcl::selective_seg::ViewProjection::Forward;
+  const std::size_t key = text.find("\"projection\"");
+  if (key != std::string::npos && key < at) {
+    const std::size_t colon = text.find_first_not_of(" \t\r\n", key + 12);
+    const std::size_t value = colon != std::string::npos && text[colon] == ':'
+                                  ? text.find_first_not_of(" \t\r\n", colon + 1)
+                                  : std::string::npos;
+    if (value != std::string::npos && text.compare(value, 11, "\"panoramic\"") == 0)
+      projection = pcl::selective_seg::ViewProjection::Panoramic;
+    else if (value == std::string::npos || text.compare(value, 9, "\"forward\"") != 0) {
+      error = "'" + path + "' names a projection other than \"forward\" or " +
+              "\"panoramic\".";
+      return false;
+    }
+  }
   while ((at = text.find('{', at)) != std::string::npos) {
     const std::size_t end = text.find('}', at);
     if (end == std::string::npos || end > list_end)

@@ -9,7 +9,11 @@
 #include <pcl/console/parse.h>
 #include <pcl/console/print.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <string>
+#include <vector>
 
 #include "segmentation_options.h"
 
@@ -168,9 +172,23 @@ parseRegionOptions(int argc,
       return false;
     }
   if (pcl::console::find_argument(argc, argv, "-roi_weights") >= 0) {
+    // Each value read whole and finite (pcl::console's atof read "a" as 0).
+    std::string text;
+    pcl::console::parse_argument(argc, argv, "-roi_weights", text);
     std::vector<double> w;
-    if (pcl::console::parse_x_arguments(argc, argv, "-roi_weights", w) < 0 ||
-        w.size() != 5) {
+    bool numbers = true;
+    std::size_t begin = 0;
+    while (numbers && begin <= text.size()) {
+      const std::size_t end = std::min(text.find(',', begin), text.size());
+      const std::string item = text.substr(begin, end - begin);
+      char* stop = nullptr;
+      const double value = std::strtod(item.c_str(), &stop);
+      numbers =
+          !item.empty() && stop == item.c_str() + item.size() && std::isfinite(value);
+      w.push_back(value);
+      begin = end + 1;
+    }
+    if (!numbers || w.size() != 5) {
       pcl::console::print_error(
           "Option -roi_weights needs 5 comma-separated numbers.\n");
       return false;

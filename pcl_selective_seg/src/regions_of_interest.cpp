@@ -712,11 +712,25 @@ windowSolidAngle(double theta_min,
     return (theta_max - theta_min) * (std::sin(phi_max) - std::sin(phi_min));
   // On the plane z = 1 the window is the rectangle [tan theta] x [tan phi]; the solid
   // angle of [0, u] x [0, v] there is atan(u v / sqrt(1 + u^2 + v^2)).
+  const double u0 = std::tan(theta_min), u1 = std::tan(theta_max);
+  const double v0 = std::tan(phi_min), v1 = std::tan(phi_max);
+  // A small window: the four corners' terms cancel to rounding (a window of 1e-9 rad
+  // came out negative), so the rectangle's area du dv times the density
+  // (1 + u^2 + v^2)^(-3/2) at its centre, whose relative error is below the squared
+  // size, 1e-8 at most here.
+  if (theta_max - theta_min < 1e-4 && phi_max - phi_min < 1e-4) {
+    // tan a - tan b = sin(a - b) / (cos a cos b), without the cancellation.
+    const double du =
+        std::sin(theta_max - theta_min) / (std::cos(theta_max) * std::cos(theta_min));
+    const double dv =
+        std::sin(phi_max - phi_min) / (std::cos(phi_max) * std::cos(phi_min));
+    const double u = 0.5 * (u0 + u1), v = 0.5 * (v0 + v1);
+    const double w = 1.0 + u * u + v * v;
+    return du * dv / (w * std::sqrt(w));
+  }
   const auto corner = [](double u, double v) {
     return std::atan(u * v / std::sqrt(1.0 + u * u + v * v));
   };
-  const double u0 = std::tan(theta_min), u1 = std::tan(theta_max);
-  const double v0 = std::tan(phi_min), v1 = std::tan(phi_max);
   return corner(u1, v1) - corner(u0, v1) - corner(u1, v0) + corner(u0, v0);
 }
 
@@ -763,7 +777,7 @@ computeRegionsOfInterest(const SegmentationResult& result,
     }
   const auto nt = static_cast<pcl::index_t>(tri.triangles.size());
   for (std::size_t t = 0; t < tri.triangles.size(); ++t)
-    for (int k = 0; k < 3; ++k)
+    for (int k = 0; k < 3; ++k) {
       if (tri.triangles[t][k] < 0 ||
           static_cast<std::size_t>(tri.triangles[t][k]) >= nv ||
           result.mesh.neighbours[t][k] < -1 || result.mesh.neighbours[t][k] >= nt) {
@@ -773,6 +787,15 @@ computeRegionsOfInterest(const SegmentationResult& result,
             t);
         return false;
       }
+      // The result's mesh names each corner by its point: the triangulation's.
+      if (result.mesh.triangles[t][k] != tri.vertex_point[tri.triangles[t][k]]) {
+        PCL_ERROR("[pcl::selective_seg::computeRegionsOfInterest] triangle %zu of the "
+                  "result does not join the triangulation's points (a result of "
+                  "another cloud, or of the same points in another order?)\n",
+                  t);
+        return false;
+      }
+    }
   if (nv == 0)
     return true;
   const double q = tri.angle_quantization;

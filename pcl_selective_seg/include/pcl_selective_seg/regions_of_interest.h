@@ -106,8 +106,10 @@ struct PCL_EXPORTS RegionOfInterestParameters {
   // --- windows ---
   /** \brief Evidence is split into tiles of at most this size in each angle before
    * windows are made (a long diagonal edge becomes a staircase of small windows rather
-   * than one large one); merged windows never exceed it either [rad].
-   * Valid: [1e-9, pi]. */
+   * than one large one), and two windows merge only into one that fits it [rad]. The
+   * margins come on top: a window can exceed it by twice its margin. Windows whose
+   * margins overlap without meeting the merge rule stay apart, and the budget counts
+   * each one's own estimate, so an overlap is counted twice. Valid: [1e-9, pi]. */
   double max_window_size = 0.05;
   /** \brief Windows smaller than this in an angle are widened to it, about their
    * centre [rad]. Valid: [0, max_window_size]. */
@@ -174,8 +176,11 @@ struct RegionOfInterest {
   double theta_max = 0.0;
   double phi_min = 0.0;
   double phi_max = 0.0;
-  /** Axis-aligned box, in the cloud frame, of the points of the segmented scan whose
-   * angles lie in the window [m] (empty box, min > max, when none does). */
+  /** Axis-aligned box, in the cloud frame, of the mesh vertices whose angles lie in the
+   * window [m]: each vertex's representative point (the nearest to the sensor among
+   * the points sharing its ray; farther points on that ray are not in the box), within
+   * float rounding (the positions pass through the sensor frame). An empty box (min >
+   * max) when no vertex lies in the window. */
   Eigen::Vector3f box_min = Eigen::Vector3f::Zero();
   Eigen::Vector3f box_max = Eigen::Vector3f::Zero();
   /** The weighted share of the window's area that its evidence stands for (each
@@ -210,9 +215,10 @@ struct RegionOfInterestStats {
   std::size_t selected_points = 0;   ///< sum of estimated_points
 };
 
-/** \brief Solid angle of an angular window [sr], exact: of eq. 1's angles a rectangle
- * on the plane z = 1; of the panoramic azimuth and elevation (theta_max - theta_min)
- * (sin phi_max - sin phi_min). */
+/** \brief Solid angle of an angular window [sr]: of eq. 1's angles a rectangle on the
+ * plane z = 1 (exact; below 1e-4 rad a side, where the exact formula's terms cancel,
+ * its area times the density at its centre, within 1e-8 relative); of the panoramic
+ * azimuth and elevation (theta_max - theta_min)(sin phi_max - sin phi_min). */
 PCL_EXPORTS double
 windowSolidAngle(double theta_min,
                  double theta_max,
@@ -256,8 +262,8 @@ PCL_EXPORTS bool computeRegionsOfInterest(const SegmentationResult& result,
                                           RegionOfInterestStats* stats = nullptr);
 
 /** \brief The same for a SelectiveSegmentation after a successful extract() or
- * update(), with the sensor pose of its input cloud (sensor_origin_ /
- * sensor_orientation_); pass the pose when setSensorPose() overrode it. */
+ * update(), with the sensor pose of that run (SelectiveSegmentation::getSensorPose():
+ * setSensorPose()'s, or the input cloud's sensor_origin_ / sensor_orientation_). */
 template <typename Segmentation>
 bool
 computeRegionsOfInterest(const Segmentation& seg,
@@ -265,13 +271,12 @@ computeRegionsOfInterest(const Segmentation& seg,
                          std::vector<RegionOfInterest>& regions,
                          RegionOfInterestStats* stats = nullptr)
 {
-  Eigen::Affine3f pose = Eigen::Affine3f::Identity();
-  if (const auto cloud = seg.getInputCloud()) {
-    pose.translation() = cloud->sensor_origin_.template head<3>();
-    pose.linear() = cloud->sensor_orientation_.normalized().toRotationMatrix();
-  }
-  return computeRegionsOfInterest(
-      seg.getResult(), seg.getTriangulation(), pose, params, regions, stats);
+  return computeRegionsOfInterest(seg.getResult(),
+                                  seg.getTriangulation(),
+                                  seg.getSensorPose(),
+                                  params,
+                                  regions,
+                                  stats);
 }
 
 } // namespace selective_seg

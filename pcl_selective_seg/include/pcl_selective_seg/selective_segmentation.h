@@ -182,6 +182,13 @@ public:
   }
   /** \brief Use the input cloud's sensor_origin_ / sensor_orientation_ again. */
   void resetSensorPose() { delaunay_.resetSensorPose(); }
+  /** \brief The sensor pose of the last run (setSensorPose()'s, or the cloud's), which
+   * its results are in; before any run, the pose in use. */
+  Eigen::Affine3f getSensorPose() const
+  {
+    return mesh_pose_.isZero() ? delaunay_.getSensorPose()
+                               : Eigen::Affine3f(mesh_pose_);
+  }
 
   /** \brief Run the whole pipeline.
    * \param[out] clusters the segments' point indices, largest first (segment i has
