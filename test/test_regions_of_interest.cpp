@@ -878,13 +878,25 @@ TEST_F(CubeRegions, NoMergeableOverlapRemains)
     }
 }
 
-// Windows are in the sensor frame: moving and turning the sensor together with the
-// scene changes no window; the boxes follow the cloud frame.
-TEST_F(CubeRegions, SensorFrameWithARotatedSensor)
+namespace {
+
+/** A sensor pose moved and turned off the identity. */
+Eigen::Affine3f
+movedSensorPose()
 {
   Eigen::Affine3f pose = Eigen::Affine3f::Identity();
   pose.translate(Eigen::Vector3f(1.0f, -2.0f, 0.5f));
   pose.rotate(Eigen::AngleAxisf(0.7f, Eigen::Vector3f(0.3f, 1.0f, -0.2f).normalized()));
+  return pose;
+}
+
+} // namespace
+
+// Windows are in the sensor frame: moving and turning the sensor together with the
+// scene changes no window; the boxes follow the cloud frame.
+TEST_F(CubeRegions, SensorFrameWithARotatedSensor)
+{
+  const Eigen::Affine3f pose = movedSensorPose();
   auto moved = pcl::make_shared<pcl::PointCloud<pcl::PointXYZL>>();
   pcl::transformPointCloud(*cloud_, *moved, pose);
   moved->sensor_origin_.head<3>() = pose.translation();
@@ -945,9 +957,7 @@ TEST_F(CubeRegions, ShuffledCloudGivesTheSameWindows)
 // with the triangulation of a shuffled copy of its cloud was accepted.
 TEST_F(CubeRegions, OverloadUsesTheRunsPoseAndAForeignResultIsRefused)
 {
-  Eigen::Affine3f pose = Eigen::Affine3f::Identity();
-  pose.translate(Eigen::Vector3f(1.0f, -2.0f, 0.5f));
-  pose.rotate(Eigen::AngleAxisf(0.7f, Eigen::Vector3f(0.3f, 1.0f, -0.2f).normalized()));
+  const Eigen::Affine3f pose = movedSensorPose();
   auto moved = pcl::make_shared<pcl::PointCloud<pcl::PointXYZL>>();
   pcl::transformPointCloud(*cloud_, *moved, pose);
   SelectiveSegmentation<pcl::PointXYZL> seg;
