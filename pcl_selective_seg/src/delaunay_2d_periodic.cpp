@@ -20,11 +20,8 @@ namespace {
 using detail::inCircle;
 using detail::setError;
 
-bool
-lexicographicallyLess(const QuantizedPoint& a, const QuantizedPoint& b)
-{
-  return a[0] < b[0] || (a[0] == b[0] && a[1] < b[1]);
-}
+// QuantizedPoint is a std::array: its operator< is the (x, y) lexicographic order the
+// strip, the kept-copy rule and the canonical fan use.
 
 /** The strip: the points and the sentinels, and copies shifted by -+ period of those
  * within a margin of the ends. Sorted by (x, y) when the points are (the sweep then
@@ -95,8 +92,7 @@ makeStrip(const std::vector<QuantizedPoint>& points,
   std::size_t i = 0, j = 0;
   while (i < data.points.size() || j < guard.points.size()) {
     const bool from_data = j == guard.points.size() ||
-                           (i < data.points.size() &&
-                            lexicographicallyLess(data.points[i], guard.points[j]));
+                           (i < data.points.size() && data.points[i] < guard.points[j]);
     const Strip& from = from_data ? data : guard;
     std::size_t& k = from_data ? i : j;
     strip.add(from.points[k], from.source[k], from.copy[k]);
@@ -121,7 +117,7 @@ keepOneCopy(const Strip& strip,
   for (const Triangle& t : strip_triangles) {
     index_t smallest = t[0];
     for (int i = 1; i < 3; ++i)
-      if (lexicographicallyLess(strip.points[t[i]], strip.points[smallest]))
+      if (strip.points[t[i]] < strip.points[smallest])
         smallest = t[i];
     if (strip.copy[smallest])
       continue;
@@ -362,11 +358,10 @@ delaunay2dPeriodic(const std::vector<QuantizedPoint>& points,
   // Duplicates, named by their ids in the input (the strip's would mislead).
   // (Sorted already when they are the vertices of SphericalDelaunay.)
   std::vector<QuantizedPoint> sorted_copy;
-  const bool in_order =
-      std::is_sorted(points.begin(), points.end(), lexicographicallyLess);
+  const bool in_order = std::is_sorted(points.begin(), points.end());
   if (!in_order) {
     sorted_copy = points;
-    std::sort(sorted_copy.begin(), sorted_copy.end(), lexicographicallyLess);
+    std::sort(sorted_copy.begin(), sorted_copy.end());
   }
   const std::vector<QuantizedPoint>& sorted_points = in_order ? points : sorted_copy;
   const auto duplicate = std::adjacent_find(sorted_points.begin(), sorted_points.end());

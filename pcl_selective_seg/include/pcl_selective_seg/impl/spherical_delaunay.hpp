@@ -304,34 +304,31 @@ bool
 SphericalDelaunay<PointT>::triangulateVertices()
 {
   std::string why;
+  bool ok;
   if (projection_ == ViewProjection::Panoramic) {
+    // The periodic triangulation makes the adjacency anyway (its checks read it).
     std::vector<Triangle> neighbours;
-    const bool ok = delaunay2dPeriodic(triangulation_.vertex_angles,
-                                       panoramicPeriod(angle_quantization_),
-                                       backend_,
-                                       triangulation_.triangles,
-                                       neighbours,
-                                       triangulation_.seam_closed,
-                                       &why,
-                                       num_threads_);
-    if (!ok)
-      PCL_ERROR("[pcl::selective_seg::%s::triangulate] %s\n",
-                getClassName().c_str(),
-                why.c_str());
+    ok = delaunay2dPeriodic(triangulation_.vertex_angles,
+                            panoramicPeriod(angle_quantization_),
+                            backend_,
+                            triangulation_.triangles,
+                            neighbours,
+                            triangulation_.seam_closed,
+                            &why,
+                            num_threads_);
     if (compute_neighbours_)
       triangulation_.neighbours.swap(neighbours);
-    return ok;
-  }
-  const bool ok =
-      compute_neighbours_
-          ? delaunay2d(triangulation_.vertex_angles,
-                       backend_,
-                       triangulation_.triangles,
-                       triangulation_.neighbours,
-                       &why,
-                       num_threads_)
-          : delaunay2d(
-                triangulation_.vertex_angles, backend_, triangulation_.triangles, &why);
+  } else
+    ok = compute_neighbours_ ? delaunay2d(triangulation_.vertex_angles,
+                                          backend_,
+                                          triangulation_.triangles,
+                                          triangulation_.neighbours,
+                                          &why,
+                                          num_threads_)
+                             : delaunay2d(triangulation_.vertex_angles,
+                                          backend_,
+                                          triangulation_.triangles,
+                                          &why);
   if (!ok)
     PCL_ERROR("[pcl::selective_seg::%s::triangulate] %s\n",
               getClassName().c_str(),
