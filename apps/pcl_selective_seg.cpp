@@ -374,11 +374,13 @@ writeOutputs(const Options& opt,
       return false;
     }
     print_info("Regions of interest: %zu chosen (%.4f sr, %zu points estimated) of %zu "
-               "candidates; %zu already fine, %zu over the budget\n",
+               "candidates, %zu cut around a window chosen before; %zu already fine, "
+               "%zu over the budget\n",
                stats.selected,
                stats.selected_solid_angle,
                stats.selected_points,
                stats.candidates,
+               stats.cut,
                stats.already_fine,
                stats.over_budget);
   }
@@ -405,7 +407,7 @@ writeOutputs(const Options& opt,
             }) &&
       write(opt.roi_json, [&](const std::string& f) {
         return writeRegionsJson(
-            f, opt.input, opt.roi, stats, regions, opt.params.projection);
+            f, opt.input, opt.roi, stats, regions, opt.params.projection, &pose);
       });
   if (ok && !outputs.commit(error)) {
     print_error("%s\n", error.c_str());

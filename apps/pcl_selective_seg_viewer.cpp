@@ -113,6 +113,9 @@ struct Scene {
   SegmentationResult result;
   NormalCloud::ConstPtr normals;
   std::vector<pcl::selective_seg::RegionOfInterest> regions;
+  /** Sensor to cloud frame of the regions' windows: the scan's, or the pose a regions
+   * file records. */
+  Eigen::Affine3f regions_pose = Eigen::Affine3f::Identity();
 };
 
 void
@@ -335,6 +338,7 @@ segment(const Options& opt, Scene& scene)
   }
   scene.result = seg.getResult();
   scene.normals = seg.getPointNormals();
+  scene.regions_pose = scene.sensor_pose;
   if (opt.roi) {
     pcl::selective_seg::RegionOfInterestStats stats;
     if (!pcl::selective_seg::computeRegionsOfInterest(scene.result,
@@ -351,9 +355,20 @@ segment(const Options& opt, Scene& scene)
                stats.candidates);
   } else if (!opt.roi_json.empty()) {
     std::string error;
-    if (!selseg_apps::readRegionsJson(opt.roi_json, scene.regions, error)) {
+    Eigen::Affine3f pose;
+    bool has_pose = false;
+    if (!selseg_apps::readRegionsJson(
+            opt.roi_json, scene.regions, pose, has_pose, error)) {
       print_error("%s\n", error.c_str());
       return false;
+    }
+    // The windows are drawn from the sensor pose they were computed with.
+    if (has_pose) {
+      if (!pose.matrix().isApprox(scene.sensor_pose.matrix(), 1e-5f))
+        print_warn(
+            "The regions file's sensor pose is not the scan's: its windows are "
+            "drawn from the file's pose, the scan's segments from the scan's.\n");
+      scene.regions_pose = pose;
     }
     print_info("Read %zu regions of interest from '%s'\n",
                scene.regions.size(),
@@ -529,7 +544,7 @@ buildNormals(const Scene& scene, int step)
 PolyData
 buildRegions(const Scene& scene)
 {
-  const Eigen::Affine3f to_sensor = scene.sensor_pose.inverse();
+  const Eigen::Affine3f to_sensor = scene.regions_pose.inverse();
   const bool panoramic =
       !scene.regions.empty() &&
       scene.regions.front().projection == pcl::selective_seg::ViewProjection::Panoramic;
@@ -560,7 +575,7 @@ buildRegions(const Scene& scene)
               : Eigen::Vector3f(static_cast<float>(std::tan(theta)),
                                 static_cast<float>(std::tan(phi)),
                                 1.0f);
-      const Eigen::Vector3f p = scene.sensor_pose * (depth * ray);
+      const Eigen::Vector3f p = scene.regions_pose * (depth * ray);
       ids[c] = points->InsertNextPoint(p.data());
     }
     ids[4] = ids[0];

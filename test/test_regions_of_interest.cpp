@@ -745,6 +745,106 @@ TEST(RegionsOfInterest, OverlappingWindowsMerge)
     EXPECT_LE(r.theta_max - r.theta_min, 0.03 + 0.01 + 1e-9);
 }
 
+// Hand-computed: a band of invalid edge triangles across a grid (vertex rows 9 and 10,
+// phi = -0.01 and 0) crosses a small segment two columns wide (theta = -0.06 and -0.05,
+// every row). Their windows cross like a plus sign and do not merge (the bounding
+// window is five times the area they cover). The band's window comes first (every
+// vertex of it evidence of weight 1, against 0.6 for most of the segment's), and the
+// segment's is cut around it: a part below and a part above, each fitted to its
+// evidence plus half a spacing, up to the band's window. The budget counts the view
+// they cover once.
+TEST(RegionsOfInterest, CrossingWindowsAreCutApart)
+{
+  GridMesh g = makeGrid(20, 20, 0.01, 9);
+  const int rows = 20;
+  std::size_t small = 0;
+  for (int c = 4; c <= 5; ++c)
+    for (int r = 0; r < rows; ++r, ++small)
+      g.result.labels[static_cast<std::size_t>(c * rows + r)] = 2;
+  g.result.segments[0].num_points = 400 - small;
+  g.result.segments[1].num_points = small;
+  RegionOfInterestParameters p;
+  p.sparse_factor = 0.0;
+  p.small_segment_points = 50;
+  p.max_window_size = 1.0;
+  p.margin_spacings = 0.5;
+  p.leaf_sigma_threshold = 0.0;
+
+  // Overlapping, as before the cut: the band and the whole segment.
+  p.disjoint_windows = false;
+  std::vector<RegionOfInterest> whole;
+  RegionOfInterestStats stats;
+  ASSERT_TRUE(computeRegionsOfInterest(
+      g.result, g.tri, Eigen::Affine3f::Identity(), p, whole, &stats));
+  ASSERT_EQ(whole.size(), 2u);
+  EXPECT_EQ(stats.cut, 0u);
+  const RegionOfInterest band = whole[0];
+  const RegionOfInterest segment = whole[1];
+  EXPECT_EQ(band.reasons, kTransition);
+  EXPECT_EQ(segment.reasons, kSmallSegment);
+  const double e = 1e-12;
+  EXPECT_NEAR(band.theta_min, -0.105, e);
+  EXPECT_NEAR(band.theta_max, 0.095, e);
+  EXPECT_NEAR(band.phi_min, -0.015, e);
+  EXPECT_NEAR(band.phi_max, 0.005, e);
+  EXPECT_NEAR(segment.theta_min, -0.065, e);
+  EXPECT_NEAR(segment.theta_max, -0.045, e);
+  EXPECT_NEAR(segment.phi_min, -0.105, e);
+  EXPECT_NEAR(segment.phi_max, 0.095, e);
+  // Priorities: (weighted evidence area / window area) x (1 - 1/3).
+  EXPECT_NEAR(band.priority, 2.0 / 3.0, 1e-9);
+  EXPECT_NEAR(segment.priority, (36 * 0.6 + 4 * 1.0) / 40.0 * 2.0 / 3.0, 1e-9);
+  EXPECT_NEAR(
+      stats.selected_solid_angle, band.solid_angle + segment.solid_angle, 1e-15);
+
+  p.disjoint_windows = true;
+  std::vector<RegionOfInterest> regions;
+  ASSERT_TRUE(computeRegionsOfInterest(
+      g.result, g.tri, Eigen::Affine3f::Identity(), p, regions, &stats));
+  ASSERT_EQ(regions.size(), 3u);
+  EXPECT_EQ(stats.candidates, 2u);
+  EXPECT_EQ(stats.cut, 1u);
+  EXPECT_EQ(stats.selected, 3u);
+  EXPECT_EQ(regions[0].theta_min, band.theta_min);
+  EXPECT_EQ(regions[0].theta_max, band.theta_max);
+  EXPECT_EQ(regions[0].phi_min, band.phi_min);
+  EXPECT_EQ(regions[0].phi_max, band.phi_max);
+  EXPECT_EQ(regions[0].priority, band.priority);
+  // Below, then above (equal priorities: 18 vertices of weight 0.6 over 0.02 x 0.09).
+  const RegionOfInterest& below = regions[1];
+  const RegionOfInterest& above = regions[2];
+  for (const auto* part : {&below, &above}) {
+    EXPECT_EQ(part->reasons, kSmallSegment);
+    EXPECT_EQ(part->num_evidence, 18u);
+    EXPECT_NEAR(part->theta_min, -0.065, e);
+    EXPECT_NEAR(part->theta_max, -0.045, e);
+    EXPECT_NEAR(part->priority, 0.6 * 2.0 / 3.0, 1e-9);
+    EXPECT_NEAR(part->current_step, 0.01, 1e-9);
+    // The vertices of rows 0-8 (or 11-19) in columns 4 and 5.
+    EXPECT_EQ(part->num_points, 18u);
+  }
+  EXPECT_NEAR(below.phi_min, -0.105, e);
+  EXPECT_EQ(below.phi_max, band.phi_min); // up to the band's window, not into it
+  EXPECT_EQ(above.phi_min, band.phi_max);
+  EXPECT_NEAR(above.phi_max, 0.095, e);
+  // The view covered once: the band plus the segment less their overlap.
+  const double overlap = windowSolidAngle(
+      segment.theta_min, segment.theta_max, band.phi_min, band.phi_max);
+  EXPECT_NEAR(stats.selected_solid_angle,
+              band.solid_angle + segment.solid_angle - overlap,
+              1e-15);
+  EXPECT_NEAR(stats.selected_solid_angle,
+              regions[0].solid_angle + below.solid_angle + above.solid_angle,
+              1e-15);
+  // A budget that holds the band and one part: the part that comes first.
+  p.max_regions = 2;
+  ASSERT_TRUE(computeRegionsOfInterest(
+      g.result, g.tri, Eigen::Affine3f::Identity(), p, regions, &stats));
+  ASSERT_EQ(regions.size(), 2u);
+  EXPECT_EQ(regions[1].phi_max, band.phi_min);
+  EXPECT_EQ(stats.over_budget, 1u);
+}
+
 // The simulated cube: without a budget the windows cover the cube's ground-truth edges
 // and little else; the budget picks the best windows; the output is deterministic.
 class CubeRegions : public ::testing::Test {
@@ -798,8 +898,7 @@ TEST_F(CubeRegions, WindowsCoverTheGroundTruthEdges)
   EXPECT_GT(fraction, 0.8) << covered << " of " << reference_->points.size();
   for (const auto& r : regions)
     EXPECT_EQ(r.reasons, kTransition);
-  // ... while the windows together (overlaps counted twice) are well under half the
-  // view (0.51 sr).
+  // ... while the windows together (disjoint) are well under half the view (0.51 sr).
   double solid_angle = 0.0;
   for (const auto& r : regions)
     solid_angle += r.solid_angle;
@@ -846,9 +945,56 @@ TEST_F(CubeRegions, BudgetsAreRespected)
   EXPECT_LE(sr, 0.01);
 }
 
+// Whatever the budget, no two selected windows overlap (they may share a border),
+// and the budget's solid angle is the sum of theirs.
+TEST_F(CubeRegions, SelectedWindowsAreDisjoint)
+{
+  RegionOfInterestParameters all = noBudget();
+  RegionOfInterestParameters points = noBudget();
+  points.max_points = 1500;
+  RegionOfInterestParameters solid = noBudget();
+  solid.max_solid_angle = 0.02;
+  RegionOfInterestParameters kinds = noBudget();
+  kinds.use_valid_edges = true;
+  kinds.use_edge_on = true;
+  kinds.max_window_size = 0.05;
+  kinds.margin_spacings = 2.0;
+  std::size_t cuts = 0;
+  for (const auto& p : {all, points, solid, kinds}) {
+    std::vector<RegionOfInterest> regions;
+    RegionOfInterestStats stats;
+    ASSERT_TRUE(computeRegionsOfInterest(*seg_, p, regions, &stats));
+    ASSERT_FALSE(regions.empty());
+    cuts += stats.cut;
+    double sr = 0.0;
+    for (std::size_t i = 0; i < regions.size(); ++i) {
+      const auto& a = regions[i];
+      sr += a.solid_angle;
+      for (std::size_t j = i + 1; j < regions.size(); ++j) {
+        const auto& b = regions[j];
+        const double w =
+            std::min(a.theta_max, b.theta_max) - std::max(a.theta_min, b.theta_min);
+        const double h =
+            std::min(a.phi_max, b.phi_max) - std::max(a.phi_min, b.phi_min);
+        EXPECT_FALSE(w > 0.0 && h > 0.0) << "windows " << i << " and " << j;
+      }
+      if (i > 0)
+        EXPECT_GE(regions[i - 1].priority, a.priority);
+    }
+    EXPECT_NEAR(sr, stats.selected_solid_angle, 1e-12);
+    if (p.max_solid_angle > 0.0)
+      EXPECT_LE(sr, p.max_solid_angle);
+  }
+  // The cube's windows do overlap before they are cut.
+  EXPECT_GT(cuts, 0u);
+}
+
+// The merge rule's invariant, before the cut (disjoint_windows = false): no two windows
+// that meet would merge.
 TEST_F(CubeRegions, NoMergeableOverlapRemains)
 {
-  const RegionOfInterestParameters p = noBudget();
+  RegionOfInterestParameters p = noBudget();
+  p.disjoint_windows = false;
   std::vector<RegionOfInterest> regions;
   ASSERT_TRUE(computeRegionsOfInterest(*seg_, p, regions));
   for (std::size_t i = 0; i < regions.size(); ++i)
@@ -923,6 +1069,9 @@ TEST_F(CubeRegions, SensorFrameWithARotatedSensor)
     if (same == b.end())
       continue;
     ++matched;
+    // A part cut beside another window may hold no vertex: an empty box, in both.
+    if (r.box_min.x() > r.box_max.x() || same->box_min.x() > same->box_max.x())
+      continue;
     // The cloud-frame box of the moved scan holds the moved box centre.
     const Eigen::Vector3f centre = pose * (0.5f * (r.box_min + r.box_max));
     EXPECT_TRUE((centre.array() >= same->box_min.array() - 0.05f).all() &&
@@ -1018,7 +1167,9 @@ TEST_F(CubeRegions, WindowsAlreadyFineEnoughAreDropped)
   ASSERT_TRUE(computeRegionsOfInterest(*seg_, p, regions, &kept));
   ASSERT_GT(kept.candidates, 0u);
   EXPECT_EQ(kept.already_fine, 0u);
-  EXPECT_EQ(kept.selected, kept.candidates);
+  EXPECT_EQ(kept.over_budget, 0u);
+  // Every candidate is selected whole or in parts.
+  EXPECT_GE(kept.selected + kept.cut, kept.candidates);
   for (const auto& r : regions)
     EXPECT_NEAR(r.suggested_step, r.current_step / 3.0, 1e-15 * r.current_step);
   p.min_refinement = 3.5;

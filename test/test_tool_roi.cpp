@@ -14,6 +14,7 @@
 #include <pcl/common/transforms.h>
 #include <pcl/io/pcd_io.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -221,6 +222,45 @@ TEST(RegionsJson, ReadsBackWhatWasWritten)
     EXPECT_EQ(read[i].box_max, written[i].box_max);
   }
   EXPECT_EQ(read[0].suggested_step, 0.002);
+
+  // The sensor pose round-trips; a window a few ulps wide (a part cut beside another
+  // window) and two windows sharing a border read back as they were.
+  Eigen::Affine3f pose = Eigen::Affine3f::Identity();
+  pose.translate(Eigen::Vector3f(0.5f, -1.25f, 2.0f));
+  pose.rotate(Eigen::AngleAxisf(0.6f, Eigen::Vector3f(1.0f, 2.0f, -0.5f).normalized()));
+  written[1].theta_min = 0.1;
+  written[1].theta_max = std::nextafter(std::nextafter(0.1, 1.0), 1.0);
+  written.push_back(written[1]);
+  written[2].theta_min = written[1].theta_max;
+  written[2].theta_max = 0.2;
+  ASSERT_TRUE(selseg_apps::writeRegionsJson(path,
+                                            "pose.pcd",
+                                            {},
+                                            {},
+                                            written,
+                                            pcl::selective_seg::ViewProjection::Forward,
+                                            &pose));
+  Eigen::Affine3f read_pose;
+  bool has_pose = false;
+  ASSERT_TRUE(selseg_apps::readRegionsJson(path, read, read_pose, has_pose, error))
+      << error;
+  EXPECT_TRUE(has_pose);
+  EXPECT_TRUE(read_pose.matrix().isApprox(pose.matrix(), 1e-6f));
+  ASSERT_EQ(read.size(), 3u);
+  EXPECT_EQ(read[1].theta_max, written[1].theta_max);
+  EXPECT_EQ(read[2].theta_min, read[1].theta_max);
+  written.pop_back();
+  // A damaged pose is an error; a file without one reads with the identity.
+  std::ofstream(path) << "{\"sensor_pose\": {\"origin\": [0, 0, 0], "
+                         "\"orientation_wxyz\": [0, 0, 0, 0]}, \"regions\": []}";
+  EXPECT_FALSE(selseg_apps::readRegionsJson(path, read, read_pose, has_pose, error));
+  EXPECT_NE(error.find("sensor_pose"), std::string::npos) << error;
+  std::ofstream(path) << "{\"regions\": []}";
+  ASSERT_TRUE(selseg_apps::readRegionsJson(path, read, read_pose, has_pose, error));
+  EXPECT_FALSE(has_pose);
+  EXPECT_TRUE(read_pose.matrix().isIdentity());
+  ASSERT_TRUE(
+      selseg_apps::writeRegionsJson(path, "in \"quotes\".pcd", {}, {}, written));
   // Found by review (session 24): the projection was recognized in the writer's own
   // spacing only, and a cut or garbage file read as fewer regions or none.
   const std::string whole = [&] {

@@ -43,12 +43,14 @@ findNumber(const std::string& text,
   return stop != start && std::isfinite(value);
 }
 
+/** The n numbers of the list after "key": inside [begin, end) of text, or false. */
+template <int N>
 bool
 findVector(const std::string& text,
            std::size_t begin,
            std::size_t end,
            const std::string& key,
-           Eigen::Vector3f& v)
+           Eigen::Matrix<float, N, 1>& v)
 {
   std::size_t at = text.find("\"" + key + "\":", begin);
   if (at == std::string::npos || at >= end)
@@ -57,10 +59,10 @@ findVector(const std::string& text,
   if (at == std::string::npos || at >= end)
     return false;
   const char* p = text.c_str() + at + 1;
-  for (int k = 0; k < 3; ++k) {
+  for (int k = 0; k < N; ++k) {
     char* stop = nullptr;
     v[k] = std::strtof(p, &stop);
-    if (stop == p)
+    if (stop == p || !std::isfinite(v[k]))
       return false;
     p = stop;
     while (*p == ',' || *p == ' ')
@@ -77,7 +79,8 @@ writeRegionsJson(const std::string& path,
                  const pcl::selective_seg::RegionOfInterestParameters& p,
                  const pcl::selective_seg::RegionOfInterestStats& s,
                  const std::vector<RegionOfInterest>& regions,
-                 pcl::selective_seg::ViewProjection projection)
+                 pcl::selective_seg::ViewProjection projection,
+                 const Eigen::Affine3f* sensor_pose)
 {
   const bool panoramic = projection == pcl::selective_seg::ViewProjection::Panoramic;
   std::ofstream out(path);
@@ -85,24 +88,34 @@ writeRegionsJson(const std::string& path,
       << ",\n  \"projection\": \"" << (panoramic ? "panoramic" : "forward")
       << "\",\n  \"frames\": \"windows: sensor frame, theta = atan2(x, z), phi = "
       << (panoramic ? "atan2(y, sqrt(x^2 + z^2))" : "atan2(y, z)")
-      << " [rad]; boxes: cloud frame [m]\",\n"
-      << "  \"budget\": {\"max_solid_angle_sr\": " << p.max_solid_angle
+      << " [rad]; boxes: cloud frame [m]\",\n";
+  if (sensor_pose) {
+    const Eigen::Quaternionf q(sensor_pose->linear());
+    out << "  \"sensor_pose\": {\"origin\": ";
+    putVector(out, sensor_pose->translation());
+    out << ", \"orientation_wxyz\": [" << q.w() << ", " << q.x() << ", " << q.y()
+        << ", " << q.z() << "]},\n";
+  }
+  out << "  \"budget\": {\"max_solid_angle_sr\": " << p.max_solid_angle
       << ", \"max_points\": " << p.max_points << ", \"max_regions\": " << p.max_regions
       << ", \"target_step_rad\": " << p.target_step
       << ", \"sample_yield\": " << p.sample_yield << "},\n"
       << "  \"counts\": {\"transition_vertices\": " << s.transition_vertices
       << ", \"small_segment_vertices\": " << s.small_segment_vertices
       << ", \"sparse_vertices\": " << s.sparse_vertices
-      << ", \"candidates\": " << s.candidates
+      << ", \"candidates\": " << s.candidates << ", \"cut\": " << s.cut
       << ", \"already_fine\": " << s.already_fine
       << ", \"over_budget\": " << s.over_budget << ", \"selected\": " << s.selected
       << ", \"selected_solid_angle_sr\": " << s.selected_solid_angle
       << ", \"selected_points\": " << s.selected_points << "},\n  \"regions\": [";
   for (std::size_t i = 0; i < regions.size(); ++i) {
     const auto& r = regions[i];
-    out << (i ? ",\n    " : "\n    ") << "{\"theta_min\": " << r.theta_min
-        << ", \"theta_max\": " << r.theta_max << ", \"phi_min\": " << r.phi_min
-        << ", \"phi_max\": " << r.phi_max << ", \"box_min\": ";
+    // The window's angles to the last bit: neighbours that share a border, and thin
+    // windows, read back as they were.
+    out << std::setprecision(17) << (i ? ",\n    " : "\n    ")
+        << "{\"theta_min\": " << r.theta_min << ", \"theta_max\": " << r.theta_max
+        << ", \"phi_min\": " << r.phi_min << ", \"phi_max\": " << r.phi_max
+        << std::setprecision(9) << ", \"box_min\": ";
     putVector(out, r.box_min);
     out << ", \"box_max\": ";
     putVector(out, r.box_max);
@@ -124,7 +137,21 @@ readRegionsJson(const std::string& path,
                 std::vector<RegionOfInterest>& regions,
                 std::string& error)
 {
+  Eigen::Affine3f pose;
+  bool has_pose = false;
+  return readRegionsJson(path, regions, pose, has_pose, error);
+}
+
+bool
+readRegionsJson(const std::string& path,
+                std::vector<RegionOfInterest>& regions,
+                Eigen::Affine3f& sensor_pose,
+                bool& has_pose,
+                std::string& error)
+{
   regions.clear();
+  sensor_pose = Eigen::Affine3f::Identity();
+  has_pose = false;
   std::ifstream in(path);
   if (!in) {
     error = "Cannot read '" + path + "'.";
@@ -162,6 +189,28 @@ readRegionsJson(const std::string& path,
               "\"panoramic\".";
       return false;
     }
+  }
+  // "sensor_pose": {"origin": [x, y, z], "orientation_wxyz": [w, x, y, z]}, before
+  // the list.
+  const std::size_t pose_key = text.find("\"sensor_pose\"");
+  if (pose_key != std::string::npos && pose_key < at) {
+    const std::size_t pose_end = text.find('}', pose_key);
+    Eigen::Vector3f origin;
+    Eigen::Vector4f wxyz;
+    if (pose_end == std::string::npos || pose_end > at ||
+        !findVector(text, pose_key, pose_end, "origin", origin) ||
+        !findVector(text, pose_key, pose_end, "orientation_wxyz", wxyz) ||
+        !(wxyz.norm() > 0.5f && wxyz.norm() < 2.0f)) {
+      error = "'" + path + "': \"sensor_pose\" needs a finite \"origin\" [x, y, z] " +
+              "and a unit quaternion \"orientation_wxyz\" [w, x, y, z].";
+      return false;
+    }
+    sensor_pose = Eigen::Affine3f::Identity();
+    sensor_pose.translation() = origin;
+    sensor_pose.linear() = Eigen::Quaternionf(wxyz[0], wxyz[1], wxyz[2], wxyz[3])
+                               .normalized()
+                               .toRotationMatrix();
+    has_pose = true;
   }
   while ((at = text.find('{', at)) != std::string::npos) {
     const std::size_t end = text.find('}', at);

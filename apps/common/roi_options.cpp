@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "segmentation_options.h"
@@ -34,7 +35,7 @@ regionFlags()
       "-roi_min_component",  "-roi_valid_edges",     "-roi_sparse_factor",
       "-roi_leaf_sigma_deg", "-roi_side_deg",        "-roi_edge_on_deg",
       "-roi_edge_on",        "-roi_sparse_by_area",  "-roi_weights",
-      "-roi_side_points",    "-roi_side_confidence"};
+      "-roi_side_points",    "-roi_side_confidence", "-roi_disjoint"};
   return flags;
 }
 
@@ -62,6 +63,9 @@ printRegionHelp()
       "  -roi_min_window_deg X    smallest window side (default %g)\n"
       "  -roi_margin_deg X        margin around the evidence (default %g)\n"
       "  -roi_margin_spacings X   margin in units of the local spacing (default %g)\n"
+      "  -roi_disjoint 0|1        windows that overlap one chosen before them are cut "
+      "around it: no ray is\n"
+      "                           scanned twice (default %d)\n"
       "  -roi_small_points N      segments with fewer points are evidence; 0 = off "
       "(default %zu)\n"
       "  -roi_valid_edges 0|1     valid edge triangles (segment borders) are "
@@ -104,6 +108,7 @@ printRegionHelp()
       d.min_window_size / kDeg,
       d.margin / kDeg,
       d.margin_spacings,
+      d.disjoint_windows ? 1 : 0,
       d.small_segment_points,
       d.use_valid_edges ? 1 : 0,
       d.min_component_vertices,
@@ -138,7 +143,8 @@ parseRegionOptions(int argc,
          component = static_cast<double>(p.min_component_vertices),
          valid_edges = p.use_valid_edges ? 1.0 : 0.0,
          edge_on_triangles = p.use_edge_on ? 1.0 : 0.0,
-         by_area = p.sparse_by_area ? 1.0 : 0.0;
+         by_area = p.sparse_by_area ? 1.0 : 0.0,
+         disjoint = p.disjoint_windows ? 1.0 : 0.0;
   if (!parseNumber(argc, argv, "-roi_max_sr", p.max_solid_angle) ||
       !parseNumber(argc, argv, "-roi_max_points", max_points) ||
       !parseNumber(argc, argv, "-roi_max_regions", max_regions) ||
@@ -160,7 +166,8 @@ parseRegionOptions(int argc,
       !parseNumber(argc, argv, "-roi_side_confidence", p.side_confidence) ||
       !parseNumber(argc, argv, "-roi_edge_on_deg", edge_on) ||
       !parseNumber(argc, argv, "-roi_edge_on", edge_on_triangles) ||
-      !parseNumber(argc, argv, "-roi_sparse_by_area", by_area))
+      !parseNumber(argc, argv, "-roi_sparse_by_area", by_area) ||
+      !parseNumber(argc, argv, "-roi_disjoint", disjoint))
     return false;
   for (const auto& [flag, value] : {std::make_pair("-roi_max_points", max_points),
                                     std::make_pair("-roi_max_regions", max_regions),
@@ -204,21 +211,17 @@ parseRegionOptions(int argc,
   p.small_segment_points = static_cast<std::size_t>(small);
   p.min_side_points = static_cast<std::size_t>(side_points);
   p.min_component_vertices = static_cast<std::size_t>(component);
-  if (valid_edges != 0.0 && valid_edges != 1.0) {
-    pcl::console::print_error("Option -roi_valid_edges needs 0 or 1.\n");
-    return false;
+  for (const auto& [flag, value, target] :
+       {std::make_tuple("-roi_valid_edges", valid_edges, &p.use_valid_edges),
+        std::make_tuple("-roi_edge_on", edge_on_triangles, &p.use_edge_on),
+        std::make_tuple("-roi_sparse_by_area", by_area, &p.sparse_by_area),
+        std::make_tuple("-roi_disjoint", disjoint, &p.disjoint_windows)}) {
+    if (value != 0.0 && value != 1.0) {
+      pcl::console::print_error("Option %s needs 0 or 1.\n", flag);
+      return false;
+    }
+    *target = value == 1.0;
   }
-  p.use_valid_edges = valid_edges == 1.0;
-  if (edge_on_triangles != 0.0 && edge_on_triangles != 1.0) {
-    pcl::console::print_error("Option -roi_edge_on needs 0 or 1.\n");
-    return false;
-  }
-  p.use_edge_on = edge_on_triangles == 1.0;
-  if (by_area != 0.0 && by_area != 1.0) {
-    pcl::console::print_error("Option -roi_sparse_by_area needs 0 or 1.\n");
-    return false;
-  }
-  p.sparse_by_area = by_area == 1.0;
   p.target_step = step * kDeg;
   p.max_window_size = max_window * kDeg;
   p.min_window_size = min_window * kDeg;

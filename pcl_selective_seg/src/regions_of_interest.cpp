@@ -26,6 +26,8 @@ namespace {
 constexpr double kHalfPi = 0.5 * M_PI;
 /** Windows stay this far inside (-pi/2, pi/2), where eq. 1 has an image. */
 constexpr double kEdgeGuard = 1e-6;
+/** Margins that overlap a window by less than this merely touch it [rad]. */
+constexpr double kTouch = 1e-9;
 
 /** The step from b to a in (theta, phi) [rad]; with the panoramic projection theta's
  * difference is taken the short way round the seam, into (-pi, pi]. */
@@ -454,6 +456,37 @@ findEvidence(const SegmentationResult& result,
   return kinds;
 }
 
+/** The angles windows may span: a panorama's azimuth ends at +-pi (the seam), eq. 1's
+ * short of +-pi/2. */
+Window
+viewLimits(const SphericalTriangulation& tri)
+{
+  const double theta_limit =
+      tri.projection == ViewProjection::Panoramic ? M_PI : kHalfPi - kEdgeGuard;
+  Window limits;
+  limits.theta_min = -theta_limit;
+  limits.theta_max = theta_limit;
+  limits.phi_min = -kHalfPi + kEdgeGuard;
+  limits.phi_max = kHalfPi - kEdgeGuard;
+  return limits;
+}
+
+/** Grows window \a w (its evidence's extent) by \a margin on every side, and to
+ * min_window_size about its centre, within \a limits. */
+void
+growWithin(Window& w,
+           double margin,
+           const RegionOfInterestParameters& p,
+           const Window& limits)
+{
+  const double grow_theta = std::max(margin, 0.5 * (p.min_window_size - w.width()));
+  const double grow_phi = std::max(margin, 0.5 * (p.min_window_size - w.height()));
+  w.theta_min = std::max(w.theta_min - grow_theta, limits.theta_min);
+  w.theta_max = std::min(w.theta_max + grow_theta, limits.theta_max);
+  w.phi_min = std::max(w.phi_min - grow_phi, limits.phi_min);
+  w.phi_max = std::min(w.phi_max + grow_phi, limits.phi_max);
+}
+
 /** One window per (kind, mesh-connected component, tile of max_window_size).
  * \a kept receives, per vertex, the kinds of its evidence that are in a component of
  * at least min_component_vertices (the rest is ignored as noise). */
@@ -526,16 +559,7 @@ makeTileWindows(const SphericalTriangulation& tri,
       w.evidence.push_back(v);
       local.push_back(spacing[v]);
     }
-    const double margin = p.margin + p.margin_spacings * median(local);
-    const double grow_theta = std::max(margin, 0.5 * (p.min_window_size - w.width()));
-    const double grow_phi = std::max(margin, 0.5 * (p.min_window_size - w.height()));
-    // A panorama's azimuth ends at +-pi (the seam), eq. 1's short of +-pi/2.
-    const double theta_limit =
-        tri.projection == ViewProjection::Panoramic ? M_PI : kHalfPi - kEdgeGuard;
-    w.theta_min = std::max(w.theta_min - grow_theta, -theta_limit);
-    w.theta_max = std::min(w.theta_max + grow_theta, theta_limit);
-    w.phi_min = std::max(w.phi_min - grow_phi, -kHalfPi + kEdgeGuard);
-    w.phi_max = std::min(w.phi_max + grow_phi, kHalfPi - kEdgeGuard);
+    growWithin(w, p.margin + p.margin_spacings * median(local), p, viewLimits(tri));
     if (w.width() > 0.0 && w.height() > 0.0)
       windows.push_back(std::move(w));
     i = j;
@@ -606,6 +630,69 @@ mergeWindows(std::vector<Window>& windows, const RegionOfInterestParameters& p)
       }
     windows.resize(kept);
   }
+}
+
+/** The parts of window \a c outside window \a s, which overlaps it: left and right of
+ * s over c's whole height, below and above s over their common width. The parts
+ * overlap neither s nor each other. A part keeps the evidence of c whose margin (the
+ * margin of c's evidence: margin + margin_spacings x its median spacing) reaches into
+ * it, and is fitted again to that evidence plus the margin, within the part: every
+ * margin around c's evidence that s does not cover stays covered. Parts that no
+ * evidence reaches are dropped. */
+std::vector<Window>
+cutAround(const Window& c,
+          const Window& s,
+          const std::vector<Eigen::Vector2d>& angles,
+          const std::vector<std::uint8_t>& kept,
+          const std::vector<double>& spacing,
+          const RegionOfInterestParameters& p)
+{
+  std::vector<double> local;
+  for (const auto v : c.evidence)
+    local.push_back(spacing[v]);
+  const double margin = p.margin + p.margin_spacings * median(local);
+  std::array<Window, 4> limits;
+  limits.fill(c);
+  limits[0].theta_max = s.theta_min; // left
+  limits[1].theta_min = s.theta_max; // right
+  for (int k = 2; k < 4; ++k) {
+    limits[k].theta_min = std::max(c.theta_min, s.theta_min);
+    limits[k].theta_max = std::min(c.theta_max, s.theta_max);
+  }
+  limits[2].phi_max = s.phi_min; // below
+  limits[3].phi_min = s.phi_max; // above
+  std::vector<Window> out;
+  for (int k = 0; k < 4; ++k) {
+    const Window& lim = limits[k];
+    if (!(lim.width() > 0.0 && lim.height() > 0.0))
+      continue;
+    Window part;
+    part.theta_min = part.phi_min = std::numeric_limits<double>::infinity();
+    part.theta_max = part.phi_max = -std::numeric_limits<double>::infinity();
+    for (const auto v : c.evidence) {
+      const Eigen::Vector2d& a = angles[v];
+      // The margin box about a reaches into the part by more than a touch (rounding
+      // of the margins along a shared border).
+      const double reach = margin - kTouch;
+      if (!(a.x() + reach > lim.theta_min && a.x() - reach < lim.theta_max &&
+            a.y() + reach > lim.phi_min && a.y() - reach < lim.phi_max))
+        continue;
+      part.theta_min = std::min(part.theta_min, a.x());
+      part.theta_max = std::max(part.theta_max, a.x());
+      part.phi_min = std::min(part.phi_min, a.y());
+      part.phi_max = std::max(part.phi_max, a.y());
+      part.reasons |= kept[v] & c.reasons;
+      part.evidence.push_back(v);
+    }
+    if (part.evidence.empty())
+      continue;
+    growWithin(part, margin, p, lim);
+    if (part.reasons == 0)
+      part.reasons = c.reasons;
+    if (part.width() > kTouch && part.height() > kTouch)
+      out.push_back(std::move(part));
+  }
+  return out;
 }
 
 double
@@ -844,8 +931,9 @@ computeRegionsOfInterest(const SegmentationResult& result,
   mergeWindows(windows, p);
   st.candidates = windows.size();
 
-  std::vector<RegionOfInterest> candidates;
-  for (auto& w : windows) {
+  // A window as a region: steps, priority, estimates and its box. False when it is
+  // already sampled about as finely as it would be (min_refinement).
+  const auto evaluate = [&](Window& w, RegionOfInterest& r) {
     auto& ev = w.evidence;
     std::sort(ev.begin(), ev.end());
     ev.erase(std::unique(ev.begin(), ev.end()), ev.end());
@@ -857,7 +945,7 @@ computeRegionsOfInterest(const SegmentationResult& result,
       weighted += kindWeight(kept[v], strength[v], p) * s2;
       covered += s2;
     }
-    RegionOfInterest r;
+    r = RegionOfInterest();
     r.theta_min = w.theta_min;
     r.theta_max = w.theta_max;
     r.phi_min = w.phi_min;
@@ -868,10 +956,8 @@ computeRegionsOfInterest(const SegmentationResult& result,
     r.suggested_step =
         p.target_step > 0.0 ? p.target_step : r.current_step / p.refinement_factor;
     if (!(r.suggested_step > 0.0) ||
-        r.current_step < p.min_refinement * r.suggested_step) {
-      ++st.already_fine;
-      continue;
-    }
+        r.current_step < p.min_refinement * r.suggested_step)
+      return false;
     const double area = w.area();
     r.solid_angle = windowSolidAngle(
         r.theta_min, r.theta_max, r.phi_min, r.phi_max, tri.projection);
@@ -908,14 +994,63 @@ computeRegionsOfInterest(const SegmentationResult& result,
     // spacing^2), times the share of new samples a scan at the suggested step brings.
     r.priority =
         weighted / std::max(area, covered) * (1.0 - r.suggested_step / r.current_step);
-    candidates.push_back(r);
-  }
-  std::sort(candidates.begin(), candidates.end(), [](const auto& a, const auto& b) {
-    return std::tie(b.priority, a.theta_min, a.phi_min, a.theta_max, a.phi_max) <
-           std::tie(a.priority, b.theta_min, b.phi_min, b.theta_max, b.phi_max);
-  });
-  for (const auto& r : candidates) {
-    const bool fits = (p.max_regions == 0 || regions.size() < p.max_regions) &&
+    return true;
+  };
+
+  // Candidates in priority order, then by their angles (and, for a tie in all of
+  // them, in the order they were made): the greedy selection's order and the output's.
+  struct Candidate {
+    RegionOfInterest region;
+    Window window;
+  };
+  std::vector<Candidate> pool;
+  const auto before = [&pool](std::size_t i, std::size_t j) {
+    const RegionOfInterest& a = pool[i].region;
+    const RegionOfInterest& b = pool[j].region;
+    return std::tie(b.priority, a.theta_min, a.phi_min, a.theta_max, a.phi_max, i) <
+           std::tie(a.priority, b.theta_min, b.phi_min, b.theta_max, b.phi_max, j);
+  };
+  // A max-heap on "comes first".
+  const auto later = [&before](std::size_t i, std::size_t j) { return before(j, i); };
+  std::vector<std::size_t> queue;
+  const auto offer = [&](Window&& w, double cap) {
+    RegionOfInterest r;
+    if (!evaluate(w, r)) {
+      ++st.already_fine;
+      return;
+    }
+    r.priority = std::min(r.priority, cap);
+    pool.push_back({r, std::move(w)});
+    queue.push_back(pool.size() - 1);
+    std::push_heap(queue.begin(), queue.end(), later);
+  };
+  for (auto& w : windows)
+    offer(std::move(w), std::numeric_limits<double>::infinity());
+  std::vector<std::size_t> selected;
+  while (!queue.empty()) {
+    std::pop_heap(queue.begin(), queue.end(), later);
+    const std::size_t i = queue.back();
+    queue.pop_back();
+    const RegionOfInterest& r = pool[i].region;
+    // With disjoint windows, one that overlaps a window taken before it is cut around
+    // that window, and its parts are candidates again.
+    if (p.disjoint_windows) {
+      const auto hit =
+          std::find_if(selected.begin(), selected.end(), [&](std::size_t k) {
+            return overlapArea(pool[i].window, pool[k].window) > 0.0;
+          });
+      if (hit != selected.end()) {
+        ++st.cut;
+        // A part is no more urgent than its window: windows are taken, and listed, in
+        // decreasing priority.
+        const double cap = r.priority;
+        for (auto& part :
+             cutAround(pool[i].window, pool[*hit].window, angles, kept, spacing, p))
+          offer(std::move(part), cap); // may reallocate pool: r is not used after this
+        continue;
+      }
+    }
+    const bool fits = (p.max_regions == 0 || selected.size() < p.max_regions) &&
                       (p.max_points == 0 ||
                        (r.estimated_points <= p.max_points &&
                         st.selected_points <= p.max_points - r.estimated_points)) &&
@@ -925,13 +1060,15 @@ computeRegionsOfInterest(const SegmentationResult& result,
       ++st.over_budget;
       continue;
     }
-    regions.push_back(r);
+    selected.push_back(i);
     const std::size_t most = std::numeric_limits<std::size_t>::max();
     st.selected_points = r.estimated_points <= most - st.selected_points
                              ? st.selected_points + r.estimated_points
                              : most;
     st.selected_solid_angle += r.solid_angle;
   }
+  for (const std::size_t i : selected)
+    regions.push_back(pool[i].region);
   st.selected = regions.size();
   return true;
 }

@@ -365,6 +365,14 @@ LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size)
               w.phi_min >= -M_PI / 2 && w.phi_min < w.phi_max &&
               w.phi_max <= M_PI / 2 && w.solid_angle >= 0.0,
           "region of interest window");
+  // Selected windows overlap nowhere (disjoint_windows, the default).
+  for (std::size_t i = 0; i < regions.size(); ++i)
+    for (std::size_t j = i + 1; j < regions.size(); ++j)
+      check(std::min(regions[i].theta_max, regions[j].theta_max) <=
+                    std::max(regions[i].theta_min, regions[j].theta_min) ||
+                std::min(regions[i].phi_max, regions[j].phi_max) <=
+                    std::max(regions[i].phi_min, regions[j].phi_min),
+            "overlapping regions of interest");
   if (check_update)
     checkUpdate(*cloud, p, pose_bytes != 0 ? &pose : nullptr);
   return 0;

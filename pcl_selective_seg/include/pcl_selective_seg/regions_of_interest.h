@@ -107,9 +107,9 @@ struct PCL_EXPORTS RegionOfInterestParameters {
   /** \brief Evidence is split into tiles of at most this size in each angle before
    * windows are made (a long diagonal edge becomes a staircase of small windows rather
    * than one large one), and two windows merge only into one that fits it [rad]. The
-   * margins come on top: a window can exceed it by twice its margin. Windows whose
-   * margins overlap without meeting the merge rule stay apart, and the budget counts
-   * each one's own estimate, so an overlap is counted twice. Valid: [1e-9, pi]. */
+   * margins come on top: a window can exceed it by twice its margin. Windows that
+   * overlap without meeting the merge rule are cut apart (disjoint_windows). Valid:
+   * [1e-9, pi]. */
   double max_window_size = 0.05;
   /** \brief Windows smaller than this in an angle are widened to it, about their
    * centre [rad]. Valid: [0, max_window_size]. */
@@ -124,6 +124,17 @@ struct PCL_EXPORTS RegionOfInterestParameters {
    * is at most this many times the area they cover together (and fits max_window_size):
    * overlaps are removed where that wastes little. Valid: >= 1, finite. */
   double merge_area_ratio = 1.25;
+  /** \brief The selected windows overlap nowhere (they may share borders), so that a
+   * finer scan of them casts no ray twice and the budget counts each part of the view
+   * once. Candidates are taken in priority order; one that overlaps a window taken
+   * before it is cut into the parts of it left and right of that window (over its
+   * whole height) and below and above it (over their common width). Each part keeps
+   * the evidence inside it (evidence inside the window taken is that window's), is
+   * fitted again to it plus margins within the part, evaluated again (steps,
+   * priority, estimates, box) and offered again; parts without evidence, or already
+   * fine, are dropped. false: windows that do not merge may overlap, and the budget
+   * counts an overlap once for each window that holds it. */
+  bool disjoint_windows = true;
 
   // --- sampling ---
   /** \brief Suggested angular step of the finer scan [rad]; 0: each window's current
@@ -207,9 +218,13 @@ struct RegionOfInterestStats {
   std::size_t transition_vertices = 0;
   std::size_t small_segment_vertices = 0; ///< (as transition_vertices)
   std::size_t sparse_vertices = 0;        ///< (as transition_vertices)
-  std::size_t candidates = 0;        ///< windows after merging
-  std::size_t already_fine = 0;      ///< candidates dropped by min_refinement
-  std::size_t over_budget = 0;       ///< candidates left out by the budget
+  std::size_t candidates = 0;             ///< windows after merging
+  /** Candidates cut around a window selected before them (disjoint_windows). */
+  std::size_t cut = 0;
+  /** Candidates (windows after merging, and parts of cut ones) dropped by
+   * min_refinement. */
+  std::size_t already_fine = 0;
+  std::size_t over_budget = 0;       ///< candidates (and parts) left out by the budget
   std::size_t selected = 0;          ///< windows returned
   double selected_solid_angle = 0.0; ///< [sr]
   std::size_t selected_points = 0;   ///< sum of estimated_points
@@ -240,9 +255,12 @@ fisherConfidenceAngle(std::size_t n, double resultant, double confidence);
  * each component is cut into tiles of max_window_size from its smallest angles, each
  * tile gives a window (its vertices' angles plus margins), overlapping windows merge
  * (merge_area_ratio), windows already sampled at about the suggested step are dropped,
- * and the budget picks windows greedily by priority. Output order: priority
- * decreasing, then theta_min, phi_min, theta_max, phi_max increasing. The result
- * depends on the segmentation only.
+ * and the budget picks windows greedily by priority; with disjoint_windows a window
+ * that overlaps one picked before it is cut around it first. Output order: the order
+ * the budget took them, priority decreasing (among equal priorities theta_min,
+ * phi_min, theta_max, phi_max increasing, of the candidates queued at the time), so
+ * that a budget of k regions gives the first k of an unlimited run. The result depends
+ * on the segmentation only.
  *
  * \param[in] result the segmentation (labels, mesh classes, leaves)
  * \param[in] triangulation its triangulation
