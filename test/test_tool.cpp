@@ -225,6 +225,28 @@ TEST_F(Tool, PanoramicProjectionSegmentsPointsBehindTheSensor)
   EXPECT_FALSE(fs::exists(out("other.pcd")));
 }
 
+// A degree option out of range is named with its value and unit: the library checks
+// radians, and its message alone ("max_merge_angle [rad] = 3.49 is invalid") named
+// neither the option nor the unit it was given in.
+TEST_F(Tool, DegreeOptionsOutOfRangeNameTheOption)
+{
+  const std::string in = "'" + scan + "' -ignore_viewpoint -o " + out("labels.pcd");
+  const std::string log = out("log.txt");
+  for (const auto& [args, flag] :
+       {std::make_pair(std::string(" -merge_deg 200"), std::string("-merge_deg 200")),
+        std::make_pair(" -roi_json " + out("r.json") + " -roi_max_window_deg 200",
+                       std::string("-roi_max_window_deg 200"))}) {
+    const int status =
+        std::system(("'" + tool + "' " + in + args + " > '" + log + "' 2>&1").c_str());
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 2) << args;
+    const std::string text = fileBytes(log);
+    EXPECT_NE(text.find("Option " + flag + " [deg] is out of range"), std::string::npos)
+        << text;
+    EXPECT_NE(text.find("pi rad = 180 deg"), std::string::npos) << text;
+  }
+  EXPECT_FALSE(fs::exists(out("labels.pcd")));
+}
+
 TEST_F(Tool, BadOptionsAreUsageErrors)
 {
   const std::string in = "'" + scan + "' -ignore_viewpoint -o " + out("labels.pcd");

@@ -231,7 +231,19 @@ parseRegionOptions(int argc,
   p.edge_on_angle = edge_on * kDeg;
   std::string why;
   if (!p.validate(&why)) {
-    pcl::console::print_error("Region of interest %s.\n", why.c_str());
+    pcl::console::print_error(
+        "%s.\n",
+        explainDegrees("Region of interest " + why,
+                       {{"-roi_step_deg", "target_step"},
+                        {"-roi_max_window_deg", "max_window_size"},
+                        {"-roi_min_window_deg", "min_window_size"},
+                        {"-roi_margin_deg", "margin"},
+                        {"-roi_leaf_sigma_deg", "leaf_sigma_threshold"},
+                        {"-roi_side_deg", "min_side_angle"},
+                        {"-roi_edge_on_deg", "edge_on_angle"}},
+                       argc,
+                       argv)
+            .c_str());
     return false;
   }
   return true;

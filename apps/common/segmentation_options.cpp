@@ -213,6 +213,27 @@ printSegmentationHelp()
              d.num_threads);
 }
 
+std::string
+explainDegrees(const std::string& why,
+               const std::vector<std::pair<const char*, const char*>>& flags,
+               int argc,
+               char** argv)
+{
+  for (const auto& [flag, name] : flags) {
+    // The library's messages name the parameter as "parameter NAME = ..." or
+    // "parameter NAME [unit] = ...".
+    const std::string key = std::string("parameter ") + name + " ";
+    if (why.find(key) == std::string::npos)
+      continue;
+    std::string value = "(its default)";
+    pcl::console::parse_argument(argc, argv, flag, value);
+    return std::string("Option ") + flag + " " + value +
+           " [deg] is out of range; in the library's radians (pi rad = 180 deg): " +
+           why;
+  }
+  return why;
+}
+
 bool
 parseSegmentationOptions(int argc, char** argv, SelectiveSegmentationParameters& p)
 {
@@ -251,7 +272,15 @@ parseSegmentationOptions(int argc, char** argv, SelectiveSegmentationParameters&
     p.normal_spread_frame = NormalSpreadFrame::MeanNormal;
   std::string why;
   if (!p.validate(&why)) {
-    print_error("%s\n", why.c_str());
+    print_error("%s\n",
+                explainDegrees(why,
+                               {{"-split_deg", "max_normal_std_dev"},
+                                {"-merge_deg", "max_merge_angle"},
+                                {"-edge_deg", "max_edge_triangle_angle"},
+                                {"-incidence_deg", "max_view_incidence_angle"}},
+                               argc,
+                               argv)
+                    .c_str());
     return false;
   }
   return true;

@@ -14,6 +14,7 @@
 #include <cmath>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace selseg_apps {
@@ -44,6 +45,17 @@ parseNumber(int argc, char** argv, const char* flag, T& value)
 bool optionsGivenOnce(int argc,
                       char** argv,
                       const std::function<bool(const std::string&)>& takes_value);
+
+/** \brief The library's message \a why about an invalid parameter, led by the option
+ * it came from when that option is given in degrees (the library checks radians: its
+ * message alone does not say which option to fix, nor in what unit). \a flags pairs
+ * each degree option with the name of its parameter; \a why is returned as it is when
+ * it names none of them. */
+std::string
+explainDegrees(const std::string& why,
+               const std::vector<std::pair<const char*, const char*>>& flags,
+               int argc,
+               char** argv);
 
 /** \brief The flags of the segmentation parameters shared by the tools (each takes a
  * value). */
