@@ -368,21 +368,25 @@ writeOutputs(const Options& opt,
   std::vector<pcl::selective_seg::RegionOfInterest> regions;
   pcl::selective_seg::RegionOfInterestStats stats;
   if (!opt.roi_json.empty()) {
+    TicToc roi_timer;
+    roi_timer.tic();
     if (!pcl::selective_seg::computeRegionsOfInterest(
             r, seg.getTriangulation(), pose, opt.roi, regions, &stats)) {
       print_error("Computing the regions of interest failed (reason above).\n");
       return false;
     }
-    print_info("Regions of interest: %zu chosen (%.4f sr, %zu points estimated) of %zu "
-               "candidates, %zu cut around a window chosen before; %zu already fine, "
-               "%zu over the budget\n",
-               stats.selected,
-               stats.selected_solid_angle,
-               stats.selected_points,
-               stats.candidates,
-               stats.cut,
-               stats.already_fine,
-               stats.over_budget);
+    print_info(
+        "Regions of interest (%.1f ms): %zu chosen (%.4f sr, %zu points "
+        "estimated) of %zu candidates, %zu cut around a window chosen before; %zu "
+        "already fine, %zu over the budget\n",
+        roi_timer.toc(),
+        stats.selected,
+        stats.selected_solid_angle,
+        stats.selected_points,
+        stats.candidates,
+        stats.cut,
+        stats.already_fine,
+        stats.over_budget);
   }
   // The writers use the segmentation's threads (-threads, 0 = automatic).
   const int threads = pcl::selective_seg::detail::threadCount(opt.params.num_threads);

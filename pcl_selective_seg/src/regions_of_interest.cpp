@@ -6,8 +6,6 @@
 
 #include <pcl_selective_seg/regions_of_interest.h>
 
-#include "parameter_checks.h"
-
 #include <pcl/console/print.h>
 
 #include <algorithm>
@@ -17,6 +15,9 @@
 #include <numeric>
 #include <sstream>
 #include <tuple>
+#include <unordered_map>
+
+#include "parameter_checks.h"
 
 namespace pcl {
 namespace selective_seg {
@@ -167,29 +168,46 @@ vertexSpacing(const SphericalTriangulation& tri,
               const std::vector<Eigen::Vector2d>& angles)
 {
   const std::size_t nv = angles.size();
-  std::vector<std::size_t> start(nv + 1, 0);
+  // The triangles at each vertex (4-byte ids: a list of every edge length at every
+  // vertex took three times the memory, and most of the time went into faulting it in).
+  std::vector<std::uint32_t> start(nv + 1, 0);
   for (const auto& t : tri.triangles)
     for (const auto v : t)
-      start[v + 1] += 2;
+      ++start[static_cast<std::size_t>(v) + 1];
   std::partial_sum(start.begin(), start.end(), start.begin());
-  std::vector<double> lengths(start.back());
-  std::vector<std::size_t> fill(start.begin(), start.end() - 1);
-  for (const auto& t : tri.triangles)
-    for (int k = 0; k < 3; ++k) {
-      const auto a = t[k];
-      const auto b = t[(k + 1) % 3];
-      const double length = angleStep(angles[a], angles[b], tri).norm();
-      lengths[fill[a]++] = length;
-      lengths[fill[b]++] = length;
-    }
+  std::vector<std::uint32_t> at(start.back());
+  {
+    std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
+    for (std::size_t t = 0; t < tri.triangles.size(); ++t)
+      for (const auto v : tri.triangles[t])
+        at[fill[static_cast<std::size_t>(v)]++] = static_cast<std::uint32_t>(t);
+  }
+  // The median of the lengths of the two edges at the vertex of each of its triangles
+  // (at each corner that is the vertex: a triangle listed twice in a row has it twice).
   std::vector<double> spacing(nv, 0.0);
+  std::vector<double> lengths;
+  const auto length = [&](pcl::index_t a, pcl::index_t b) {
+    return angleStep(angles[static_cast<std::size_t>(a)],
+                     angles[static_cast<std::size_t>(b)],
+                     tri)
+        .norm();
+  };
   for (std::size_t v = 0; v < nv; ++v) {
-    const auto first = lengths.begin() + static_cast<std::ptrdiff_t>(start[v]);
-    const auto last = lengths.begin() + static_cast<std::ptrdiff_t>(start[v + 1]);
-    if (first == last)
+    lengths.clear();
+    for (std::uint32_t i = start[v]; i < start[v + 1]; ++i) {
+      if (i > start[v] && at[i] == at[i - 1])
+        continue;
+      const auto& t = tri.triangles[at[i]];
+      for (int k = 0; k < 3; ++k)
+        if (static_cast<std::size_t>(t[k]) == v) {
+          lengths.push_back(length(t[k], t[(k + 1) % 3]));
+          lengths.push_back(length(t[(k + 2) % 3], t[k]));
+        }
+    }
+    if (lengths.empty())
       continue;
-    const auto mid = first + (last - first) / 2;
-    std::nth_element(first, mid, last);
+    const auto mid = lengths.begin() + static_cast<std::ptrdiff_t>(lengths.size() / 2);
+    std::nth_element(lengths.begin(), mid, lengths.end());
     spacing[v] = *mid;
   }
   return spacing;
@@ -500,69 +518,103 @@ makeTileWindows(const SphericalTriangulation& tri,
 {
   const std::size_t nv = angles.size();
   kept.assign(nv, 0);
-  // (kind, component, tile theta, tile phi, vertex): sorted, groups are windows.
-  using Entry = std::tuple<int, std::size_t, std::int64_t, std::int64_t, pcl::index_t>;
-  std::vector<Entry> entries;
+  // Windows by kind, then by (component, tile theta, tile phi): each group of
+  // evidence vertices is a window, its vertices in increasing order.
+  struct Group {
+    std::array<std::int64_t, 3> key; ///< component root, tile theta, tile phi
+    Window window;
+    std::vector<double> spacing;
+  };
+  struct KeyHash {
+    std::size_t operator()(const std::array<std::int64_t, 3>& k) const
+    {
+      std::uint64_t h = 1469598103934665603ull;
+      for (const auto x : k)
+        h = (h ^ static_cast<std::uint64_t>(x)) * 1099511628211ull;
+      return static_cast<std::size_t>(h ^ (h >> 29));
+    }
+  };
+  std::vector<Window> windows;
+  std::vector<Group> groups;
+  std::unordered_map<std::array<std::int64_t, 3>, std::size_t, KeyHash> group_of;
+  // Each kind's evidence vertices, numbered compactly in increasing vertex order (so a
+  // set's root, its smallest member, is its smallest vertex).
+  std::vector<std::int32_t> slot(nv, -1);
+  std::vector<pcl::index_t> members;
   for (const std::uint8_t kind : {kTransition, kSmallSegment, kSparse}) {
-    DisjointSets sets(nv);
+    members.clear();
+    for (std::size_t v = 0; v < nv; ++v)
+      if (kinds[v] & kind) {
+        slot[v] = static_cast<std::int32_t>(members.size());
+        members.push_back(static_cast<pcl::index_t>(v));
+      }
+    if (members.empty())
+      continue;
+    DisjointSets sets(members.size());
     for (const auto& t : tri.triangles)
       for (int k = 0; k < 3; ++k) {
-        const auto a = t[k];
-        const auto b = t[(k + 1) % 3];
-        if ((kinds[a] & kind) && (kinds[b] & kind))
+        const auto a = slot[static_cast<std::size_t>(t[k])];
+        const auto b = slot[static_cast<std::size_t>(t[(k + 1) % 3])];
+        if (a >= 0 && b >= 0)
           sets.unite(static_cast<std::size_t>(a), static_cast<std::size_t>(b));
       }
     // Tiles start at the component's smallest angles: a component that fits in one
     // tile gives one window.
-    std::vector<std::size_t> size(nv, 0);
+    const std::size_t m = members.size();
+    std::vector<std::size_t> size(m, 0);
     std::vector<Eigen::Vector2d> start(
-        nv, Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity()));
-    for (std::size_t v = 0; v < nv; ++v)
-      if (kinds[v] & kind) {
-        const std::size_t root = sets.find(v);
-        ++size[root];
-        start[root] = start[root].cwiseMin(angles[v]);
-      }
-    for (std::size_t v = 0; v < nv; ++v) {
-      const std::size_t root = sets.find(v);
-      if (!(kinds[v] & kind) || size[root] < p.min_component_vertices)
+        m, Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity()));
+    for (std::size_t i = 0; i < m; ++i) {
+      const std::size_t root = sets.find(i);
+      ++size[root];
+      start[root] = start[root].cwiseMin(angles[static_cast<std::size_t>(members[i])]);
+    }
+    groups.clear();
+    group_of.clear();
+    for (std::size_t i = 0; i < m; ++i) {
+      const std::size_t root = sets.find(i);
+      const auto v = static_cast<std::size_t>(members[i]);
+      slot[v] = -1; // ready for the next kind
+      if (size[root] < p.min_component_vertices)
         continue;
       kept[v] |= kind;
       // At most pi / 1e-9 (validate()): the tile numbers fit an integer.
       const Eigen::Vector2d tile = (angles[v] - start[root]) / p.max_window_size;
-      entries.emplace_back(kind,
-                           root,
-                           static_cast<std::int64_t>(std::floor(tile.x())),
-                           static_cast<std::int64_t>(std::floor(tile.y())),
-                           static_cast<pcl::index_t>(v));
-    }
-  }
-  std::sort(entries.begin(), entries.end());
-  std::vector<Window> windows;
-  for (std::size_t i = 0; i < entries.size();) {
-    std::size_t j = i;
-    Window w;
-    w.theta_min = w.phi_min = std::numeric_limits<double>::infinity();
-    w.theta_max = w.phi_max = -std::numeric_limits<double>::infinity();
-    w.reasons = static_cast<std::uint8_t>(std::get<0>(entries[i]));
-    std::vector<double> local;
-    for (; j < entries.size() && std::get<0>(entries[j]) == std::get<0>(entries[i]) &&
-           std::get<1>(entries[j]) == std::get<1>(entries[i]) &&
-           std::get<2>(entries[j]) == std::get<2>(entries[i]) &&
-           std::get<3>(entries[j]) == std::get<3>(entries[i]);
-         ++j) {
-      const auto v = std::get<4>(entries[j]);
+      const std::array<std::int64_t, 3> key = {
+          static_cast<std::int64_t>(members[root]),
+          static_cast<std::int64_t>(std::floor(tile.x())),
+          static_cast<std::int64_t>(std::floor(tile.y()))};
+      const auto [it, fresh] = group_of.emplace(key, groups.size());
+      if (fresh) {
+        Group g;
+        g.key = key;
+        g.window.theta_min = g.window.phi_min = std::numeric_limits<double>::infinity();
+        g.window.theta_max = g.window.phi_max =
+            -std::numeric_limits<double>::infinity();
+        g.window.reasons = kind;
+        groups.push_back(std::move(g));
+      }
+      Group& g = groups[it->second];
+      Window& w = g.window;
       w.theta_min = std::min(w.theta_min, angles[v].x());
       w.theta_max = std::max(w.theta_max, angles[v].x());
       w.phi_min = std::min(w.phi_min, angles[v].y());
       w.phi_max = std::max(w.phi_max, angles[v].y());
-      w.evidence.push_back(v);
-      local.push_back(spacing[v]);
+      w.evidence.push_back(static_cast<pcl::index_t>(v));
+      g.spacing.push_back(spacing[v]);
     }
-    growWithin(w, p.margin + p.margin_spacings * median(local), p, viewLimits(tri));
-    if (w.width() > 0.0 && w.height() > 0.0)
-      windows.push_back(std::move(w));
-    i = j;
+    std::sort(groups.begin(), groups.end(), [](const Group& a, const Group& b) {
+      return a.key < b.key;
+    });
+    for (auto& g : groups) {
+      Window& w = g.window;
+      growWithin(w,
+                 p.margin + p.margin_spacings * median(std::move(g.spacing)),
+                 p,
+                 viewLimits(tri));
+      if (w.width() > 0.0 && w.height() > 0.0)
+        windows.push_back(std::move(w));
+    }
   }
   return windows;
 }
@@ -631,6 +683,90 @@ mergeWindows(std::vector<Window>& windows, const RegionOfInterestParameters& p)
     windows.resize(kept);
   }
 }
+
+/** The vertices bucketed by their angles on a uniform grid of about four vertices a
+ * cell, so that the vertices inside a window are found among the cells it overlaps
+ * rather than in its whole band of theta. */
+class VertexGrid {
+public:
+  explicit VertexGrid(const std::vector<Eigen::Vector2d>& angles)
+      : angles_(angles)
+  {
+    const std::size_t n = angles.size();
+    lo_ = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
+    Eigen::Vector2d hi = -lo_;
+    for (const auto& a : angles) {
+      lo_ = lo_.cwiseMin(a);
+      hi = hi.cwiseMax(a);
+    }
+    if (n == 0)
+      lo_ = hi = Eigen::Vector2d::Zero();
+    const Eigen::Vector2d extent = hi - lo_;
+    const double cells = std::max(1.0, static_cast<double>(n) / 4.0);
+    double cols = 1.0, rows = 1.0;
+    if (extent.x() > 0.0 && extent.y() > 0.0) {
+      cols = std::clamp(
+          std::round(std::sqrt(cells * extent.x() / extent.y())), 1.0, cells);
+      rows = std::clamp(std::round(cells / cols), 1.0, cells);
+    } else if (extent.x() > 0.0)
+      cols = cells;
+    else if (extent.y() > 0.0)
+      rows = cells;
+    size_ = {static_cast<std::int64_t>(cols), static_cast<std::int64_t>(rows)};
+    scale_ = Eigen::Vector2d(extent.x() > 0.0 ? cols / extent.x() : 0.0,
+                             extent.y() > 0.0 ? rows / extent.y() : 0.0);
+    start_.assign(static_cast<std::size_t>(size_[0] * size_[1]) + 1, 0);
+    for (const auto& a : angles)
+      ++start_[index(a.x(), a.y()) + 1];
+    std::partial_sum(start_.begin(), start_.end(), start_.begin());
+    vertices_.resize(n);
+    std::vector<std::size_t> next(start_.begin(), start_.end() - 1);
+    for (std::size_t v = 0; v < n; ++v)
+      vertices_[next[index(angles[v].x(), angles[v].y())]++] = v;
+  }
+
+  /** Calls f(v) for every vertex v whose angles lie in the window, borders included. */
+  template <typename F>
+  void forEachIn(
+      double theta_min, double theta_max, double phi_min, double phi_max, F f) const
+  {
+    const std::int64_t c0 = cell(theta_min, 0), c1 = cell(theta_max, 0);
+    const std::int64_t r0 = cell(phi_min, 1), r1 = cell(phi_max, 1);
+    for (std::int64_t c = c0; c <= c1; ++c)
+      for (std::int64_t r = r0; r <= r1; ++r) {
+        const auto k = static_cast<std::size_t>(c * size_[1] + r);
+        for (std::size_t i = start_[k]; i < start_[k + 1]; ++i) {
+          const std::size_t v = vertices_[i];
+          const Eigen::Vector2d& a = angles_[v];
+          if (a.x() >= theta_min && a.x() <= theta_max && a.y() >= phi_min &&
+              a.y() <= phi_max)
+            f(v);
+        }
+      }
+  }
+
+private:
+  /** The cell of an angle along an axis, clamped to the grid; monotone in the angle,
+   * so a vertex inside a window lies in one of the window's cells. */
+  std::int64_t cell(double x, int axis) const
+  {
+    const double t = (x - lo_[axis]) * scale_[axis];
+    if (!(t > 0.0))
+      return 0;
+    return t < static_cast<double>(size_[axis] - 1) ? static_cast<std::int64_t>(t)
+                                                    : size_[axis] - 1;
+  }
+  std::size_t index(double theta, double phi) const
+  {
+    return static_cast<std::size_t>(cell(theta, 0) * size_[1] + cell(phi, 1));
+  }
+
+  const std::vector<Eigen::Vector2d>& angles_;
+  Eigen::Vector2d lo_, scale_;
+  std::array<std::int64_t, 2> size_{{1, 1}};
+  std::vector<std::size_t> start_;    ///< first entry of each cell in vertices_
+  std::vector<std::size_t> vertices_; ///< by cell, in increasing number in each
+};
 
 /** The parts of window \a c outside window \a s, which overlaps it: left and right of
  * s over c's whole height, below and above s over their common width. The parts
@@ -862,6 +998,12 @@ computeRegionsOfInterest(const SegmentationResult& result,
                 v);
       return false;
     }
+  if (tri.triangles.size() > std::numeric_limits<std::uint32_t>::max() / 3) {
+    PCL_ERROR("[pcl::selective_seg::computeRegionsOfInterest] %zu triangles: at most "
+              "(2^32 - 1) / 3 are supported\n",
+              tri.triangles.size());
+    return false;
+  }
   const auto nt = static_cast<pcl::index_t>(tri.triangles.size());
   for (std::size_t t = 0; t < tri.triangles.size(); ++t)
     for (int k = 0; k < 3; ++k) {
@@ -931,6 +1073,7 @@ computeRegionsOfInterest(const SegmentationResult& result,
   mergeWindows(windows, p);
   st.candidates = windows.size();
 
+  const VertexGrid grid(angles);
   // A window as a region: steps, priority, estimates and its box. False when it is
   // already sampled about as finely as it would be (min_refinement).
   const auto evaluate = [&](Window& w, RegionOfInterest& r) {
@@ -967,29 +1110,19 @@ computeRegionsOfInterest(const SegmentationResult& result,
         std::round(p.sample_yield * area / (r.suggested_step * r.suggested_step));
     r.estimated_points = estimate < kMaxCount ? static_cast<std::size_t>(estimate)
                                               : std::numeric_limits<std::size_t>::max();
-    // Vertices are numbered in increasing quantized theta: the window's are a range.
-    // Their angles are compared as the window was made from them (angles[v]: the
-    // quantized angle times q, monotone in it), so evidence on a border is inside.
-    const auto first = std::lower_bound(
-        tri.vertex_angles.begin(),
-        tri.vertex_angles.end(),
-        r.theta_min,
-        [q](const QuantizedPoint& a, double t) { return a[0] * q < t; });
+    // The window's vertices, their angles compared as the window was made from them
+    // (angles[v]), so that evidence on a border is inside.
     r.box_min = Eigen::Vector3f::Constant(std::numeric_limits<float>::max());
     r.box_max = Eigen::Vector3f::Constant(std::numeric_limits<float>::lowest());
-    for (auto it = first; it != tri.vertex_angles.end() && (*it)[0] * q <= r.theta_max;
-         ++it) {
-      if ((*it)[1] * q < r.phi_min || (*it)[1] * q > r.phi_max)
-        continue;
-      const auto v = static_cast<std::size_t>(it - tri.vertex_angles.begin());
+    grid.forEachIn(r.theta_min, r.theta_max, r.phi_min, r.phi_max, [&](std::size_t v) {
       ++r.num_points;
       const Eigen::Vector3f x =
           (to_cloud * tri.vertex_positions[v].cast<double>()).cast<float>();
       if (!x.allFinite())
-        continue;
+        return;
       r.box_min = r.box_min.cwiseMin(x);
       r.box_max = r.box_max.cwiseMax(x);
-    }
+    });
     // The weighted share of the window's area its evidence stands for (each vertex
     // spacing^2), times the share of new samples a scan at the suggested step brings.
     r.priority =
