@@ -304,7 +304,11 @@ TEST(RegionsOfInterest, BadTriangulationPoseOrLeavesAreRejected)
   for (const double q : {std::numeric_limits<double>::quiet_NaN(),
                          0.0,
                          -1e-7,
-                         std::numeric_limits<double>::infinity()}) {
+                         std::numeric_limits<double>::infinity(),
+                         // Found by review (session 25): angles far beyond pi (an
+                         // infinite extent made the vertex grid write out of bounds).
+                         1e304,
+                         1.0}) {
     GridMesh g = makeGrid(10, 6, 0.01, 2);
     g.tri.angle_quantization = q;
     EXPECT_FALSE(run(g, identity)) << "quantization " << q;

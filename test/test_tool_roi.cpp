@@ -259,6 +259,25 @@ TEST(RegionsJson, ReadsBackWhatWasWritten)
   ASSERT_TRUE(selseg_apps::readRegionsJson(path, read, read_pose, has_pose, error));
   EXPECT_FALSE(has_pose);
   EXPECT_TRUE(read_pose.matrix().isIdentity());
+  // Found by review (session 25): valid JSON with spaces before the colons was refused,
+  // and an input name holding the key's letters made a file without a pose unreadable.
+  std::ofstream(path) << "{\"sensor_pose\" : {\"origin\" : [1, 2, 3], "
+                         "\"orientation_wxyz\" :\n[1,0,0,0]}, \"regions\" : [{"
+                         "\"theta_min\" : 0, \"theta_max\" : 0.1, \"phi_min\" : 0, "
+                         "\"phi_max\" : 0.1, \"reasons\" : \"sparse\"}]}";
+  ASSERT_TRUE(selseg_apps::readRegionsJson(path, read, read_pose, has_pose, error))
+      << error;
+  EXPECT_TRUE(has_pose);
+  EXPECT_EQ(read_pose.translation(), Eigen::Vector3f(1.0f, 2.0f, 3.0f));
+  ASSERT_EQ(read.size(), 1u);
+  EXPECT_EQ(read[0].theta_max, 0.1);
+  EXPECT_EQ(read[0].reasons, pcl::selective_seg::kSparse);
+  ASSERT_TRUE(selseg_apps::writeRegionsJson(
+      path, "scan \"sensor_pose\": \"projection\"", {}, {}, written));
+  ASSERT_TRUE(selseg_apps::readRegionsJson(path, read, read_pose, has_pose, error))
+      << error;
+  EXPECT_FALSE(has_pose);
+  EXPECT_EQ(read.size(), written.size());
   ASSERT_TRUE(
       selseg_apps::writeRegionsJson(path, "in \"quotes\".pcd", {}, {}, written));
   // Found by review (session 24): the projection was recognized in the writer's own

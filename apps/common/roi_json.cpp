@@ -6,6 +6,7 @@
 
 #include "roi_json.h"
 
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -26,6 +27,32 @@ putVector(std::ostream& out, const Eigen::Vector3f& v)
   out << "[" << v.x() << ", " << v.y() << ", " << v.z() << "]";
 }
 
+/** Where the value of "key" starts in [begin, end) of text, or npos: an occurrence
+ * that is a key of an object (after '{' or ',', before ':', with any spacing), not
+ * the same letters inside a string value. */
+std::size_t
+findKey(const std::string& text,
+        std::size_t begin,
+        std::size_t end,
+        const std::string& key)
+{
+  const std::string quoted = "\"" + key + "\"";
+  const char* space = " \t\r\n";
+  for (std::size_t at = text.find(quoted, begin); at != std::string::npos && at < end;
+       at = text.find(quoted, at + 1)) {
+    const std::size_t before =
+        at == 0 ? std::string::npos : text.find_last_not_of(space, at - 1);
+    if (before == std::string::npos || (text[before] != '{' && text[before] != ','))
+      continue;
+    const std::size_t colon = text.find_first_not_of(space, at + quoted.size());
+    if (colon == std::string::npos || text[colon] != ':')
+      continue;
+    const std::size_t value = text.find_first_not_of(space, colon + 1);
+    return value < end ? value : std::string::npos;
+  }
+  return std::string::npos;
+}
+
 /** The number after "key": inside [begin, end) of text, or false. */
 bool
 findNumber(const std::string& text,
@@ -34,10 +61,10 @@ findNumber(const std::string& text,
            const std::string& key,
            double& value)
 {
-  const std::size_t at = text.find("\"" + key + "\":", begin);
-  if (at == std::string::npos || at >= end)
+  const std::size_t at = findKey(text, begin, end, key);
+  if (at == std::string::npos)
     return false;
-  const char* start = text.c_str() + at + key.size() + 3;
+  const char* start = text.c_str() + at;
   char* stop = nullptr;
   value = std::strtod(start, &stop);
   return stop != start && std::isfinite(value);
@@ -52,11 +79,8 @@ findVector(const std::string& text,
            const std::string& key,
            Eigen::Matrix<float, N, 1>& v)
 {
-  std::size_t at = text.find("\"" + key + "\":", begin);
-  if (at == std::string::npos || at >= end)
-    return false;
-  at = text.find('[', at);
-  if (at == std::string::npos || at >= end)
+  const std::size_t at = findKey(text, begin, end, key);
+  if (at == std::string::npos || text[at] != '[')
     return false;
   const char* p = text.c_str() + at + 1;
   for (int k = 0; k < N; ++k) {
@@ -65,7 +89,7 @@ findVector(const std::string& text,
     if (stop == p || !std::isfinite(v[k]))
       return false;
     p = stop;
-    while (*p == ',' || *p == ' ')
+    while (*p == ',' || std::isspace(static_cast<unsigned char>(*p)))
       ++p;
   }
   return true;
@@ -160,7 +184,7 @@ readRegionsJson(const std::string& path,
   std::stringstream buffer;
   buffer << in.rdbuf();
   const std::string text = buffer.str();
-  std::size_t at = text.find("\"regions\":");
+  std::size_t at = findKey(text, 0, text.size(), "regions");
   if (at == std::string::npos) {
     error = "'" + path + "' has no \"regions\" list (write it with -roi_json).";
     return false;
@@ -176,15 +200,11 @@ readRegionsJson(const std::string& path,
   }
   // "projection": "panoramic", with any spacing (written by any JSON tool).
   auto projection = pcl::selective_seg::ViewProjection::Forward;
-  const std::size_t key = text.find("\"projection\"");
-  if (key != std::string::npos && key < at) {
-    const std::size_t colon = text.find_first_not_of(" \t\r\n", key + 12);
-    const std::size_t value = colon != std::string::npos && text[colon] == ':'
-                                  ? text.find_first_not_of(" \t\r\n", colon + 1)
-                                  : std::string::npos;
-    if (value != std::string::npos && text.compare(value, 11, "\"panoramic\"") == 0)
+  const std::size_t value = findKey(text, 0, at, "projection");
+  if (value != std::string::npos) {
+    if (text.compare(value, 11, "\"panoramic\"") == 0)
       projection = pcl::selective_seg::ViewProjection::Panoramic;
-    else if (value == std::string::npos || text.compare(value, 9, "\"forward\"") != 0) {
+    else if (text.compare(value, 9, "\"forward\"") != 0) {
       error = "'" + path + "' names a projection other than \"forward\" or " +
               "\"panoramic\".";
       return false;
@@ -192,8 +212,8 @@ readRegionsJson(const std::string& path,
   }
   // "sensor_pose": {"origin": [x, y, z], "orientation_wxyz": [w, x, y, z]}, before
   // the list.
-  const std::size_t pose_key = text.find("\"sensor_pose\"");
-  if (pose_key != std::string::npos && pose_key < at) {
+  const std::size_t pose_key = findKey(text, 0, at, "sensor_pose");
+  if (pose_key != std::string::npos) {
     const std::size_t pose_end = text.find('}', pose_key);
     Eigen::Vector3f origin;
     Eigen::Vector4f wxyz;
@@ -237,8 +257,8 @@ readRegionsJson(const std::string& path,
       r.suggested_step = step;
     if (findNumber(text, at, end, "current_step", current))
       r.current_step = current;
-    const std::size_t reasons = text.find("\"reasons\":", at);
-    if (reasons != std::string::npos && reasons < end) {
+    const std::size_t reasons = findKey(text, at, end, "reasons");
+    if (reasons != std::string::npos) {
       const std::string value = text.substr(reasons, end - reasons);
       if (value.find("transition") != std::string::npos)
         r.reasons |= pcl::selective_seg::kTransition;

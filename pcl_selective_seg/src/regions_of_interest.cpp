@@ -97,6 +97,9 @@ struct Window {
   double theta_min, theta_max, phi_min, phi_max;
   std::uint8_t reasons = 0;
   std::vector<pcl::index_t> evidence; ///< vertex ids
+  /** Evidence outside the window whose margin reaches into it (a part cut beside a
+   * window taken before it): it sizes the window, but is not its evidence. */
+  std::vector<pcl::index_t> reach;
   double width() const { return theta_max - theta_min; }
   double height() const { return phi_max - phi_min; }
   double area() const { return width() * height(); }
@@ -497,12 +500,28 @@ growWithin(Window& w,
            const RegionOfInterestParameters& p,
            const Window& limits)
 {
-  const double grow_theta = std::max(margin, 0.5 * (p.min_window_size - w.width()));
-  const double grow_phi = std::max(margin, 0.5 * (p.min_window_size - w.height()));
-  w.theta_min = std::max(w.theta_min - grow_theta, limits.theta_min);
-  w.theta_max = std::min(w.theta_max + grow_theta, limits.theta_max);
-  w.phi_min = std::max(w.phi_min - grow_phi, limits.phi_min);
-  w.phi_max = std::min(w.phi_max + grow_phi, limits.phi_max);
+  // One axis: the margin, clipped to the limits; then, if that is narrower than
+  // min_window_size, widened about its centre and moved inside the limits where they
+  // leave room.
+  const auto grow = [&](double& lo, double& hi, double limit_lo, double limit_hi) {
+    lo = std::max(lo - margin, limit_lo);
+    hi = std::min(hi + margin, limit_hi);
+    const double missing = p.min_window_size - (hi - lo);
+    if (!(missing > 0.0))
+      return;
+    lo -= 0.5 * missing;
+    hi += 0.5 * missing;
+    if (lo < limit_lo) {
+      hi = std::min(hi + (limit_lo - lo), limit_hi);
+      lo = limit_lo;
+    }
+    if (hi > limit_hi) {
+      lo = std::max(lo - (hi - limit_hi), limit_lo);
+      hi = limit_hi;
+    }
+  };
+  grow(w.theta_min, w.theta_max, limits.theta_min, limits.theta_max);
+  grow(w.phi_min, w.phi_max, limits.phi_min, limits.phi_max);
 }
 
 /** One window per (kind, mesh-connected component, tile of max_window_size).
@@ -701,7 +720,9 @@ public:
     }
     if (n == 0)
       lo_ = hi = Eigen::Vector2d::Zero();
-    const Eigen::Vector2d extent = hi - lo_;
+    Eigen::Vector2d extent = hi - lo_;
+    if (!extent.allFinite()) // not for a caller's angles (checked), but never NaN cells
+      lo_ = extent = Eigen::Vector2d::Zero();
     const double cells = std::max(1.0, static_cast<double>(n) / 4.0);
     double cols = 1.0, rows = 1.0;
     if (extent.x() > 0.0 && extent.y() > 0.0) {
@@ -768,13 +789,59 @@ private:
   std::vector<std::size_t> vertices_; ///< by cell, in increasing number in each
 };
 
+/** Windows registered in the cells of a uniform grid of angles that they overlap, for
+ * the windows near another one without a pass over all of them. */
+class WindowGrid {
+public:
+  explicit WindowGrid(double cell)
+      : cell_(cell)
+  {
+  }
+
+  /** Registers window \a w under \a id. */
+  void add(const Window& w, std::size_t id)
+  {
+    forEachCell(w, [&](std::uint64_t key) { cells_[key].push_back(id); });
+  }
+
+  /** Calls f(id) for every window registered in a cell that \a w overlaps (a window
+   * that overlaps w among them; some more than once). */
+  template <typename F> void forEachNear(const Window& w, F f) const
+  {
+    forEachCell(w, [&](std::uint64_t key) {
+      const auto it = cells_.find(key);
+      if (it != cells_.end())
+        for (const std::size_t id : it->second)
+          f(id);
+    });
+  }
+
+private:
+  template <typename F> void forEachCell(const Window& w, F f) const
+  {
+    // Angles lie within [-pi, pi] and cells are at least 1e-9 rad: the cell numbers
+    // fit 32 bits.
+    const auto at = [this](double x) {
+      return static_cast<std::int64_t>(std::floor(x / cell_));
+    };
+    for (std::int64_t c = at(w.theta_min); c <= at(w.theta_max); ++c)
+      for (std::int64_t r = at(w.phi_min); r <= at(w.phi_max); ++r)
+        f((static_cast<std::uint64_t>(c) << 32) ^
+          static_cast<std::uint64_t>(static_cast<std::uint32_t>(r)));
+  }
+
+  double cell_;
+  std::unordered_map<std::uint64_t, std::vector<std::size_t>> cells_;
+};
+
 /** The parts of window \a c outside window \a s, which overlaps it: left and right of
  * s over c's whole height, below and above s over their common width. The parts
- * overlap neither s nor each other. A part keeps the evidence of c whose margin (the
- * margin of c's evidence: margin + margin_spacings x its median spacing) reaches into
- * it, and is fitted again to that evidence plus the margin, within the part: every
- * margin around c's evidence that s does not cover stays covered. Parts that no
- * evidence reaches are dropped. */
+ * overlap neither s nor each other. A part's evidence is c's evidence inside it (c's
+ * evidence inside s, borders included, is s's); it is fitted again to that evidence
+ * and to the evidence whose margin (c's margin: margin + margin_spacings x the median
+ * spacing) reaches into it, plus the margin, within the part: every margin around c's
+ * evidence that s does not cover stays covered. Parts that no evidence reaches are
+ * dropped. */
 std::vector<Window>
 cutAround(const Window& c,
           const Window& s,
@@ -783,8 +850,10 @@ cutAround(const Window& c,
           const std::vector<double>& spacing,
           const RegionOfInterestParameters& p)
 {
+  std::vector<pcl::index_t> all = c.evidence;
+  all.insert(all.end(), c.reach.begin(), c.reach.end());
   std::vector<double> local;
-  for (const auto v : c.evidence)
+  for (const auto v : all)
     local.push_back(spacing[v]);
   const double margin = p.margin + p.margin_spacings * median(local);
   std::array<Window, 4> limits;
@@ -797,6 +866,18 @@ cutAround(const Window& c,
   }
   limits[2].phi_max = s.phi_min; // below
   limits[3].phi_min = s.phi_max; // above
+  // The part that holds a vertex of c's evidence: -1 inside s.
+  const auto owner = [&](const Eigen::Vector2d& a) {
+    if (a.x() < s.theta_min)
+      return 0;
+    if (a.x() > s.theta_max)
+      return 1;
+    if (a.y() < s.phi_min)
+      return 2;
+    if (a.y() > s.phi_max)
+      return 3;
+    return -1;
+  };
   std::vector<Window> out;
   for (int k = 0; k < 4; ++k) {
     const Window& lim = limits[k];
@@ -805,26 +886,34 @@ cutAround(const Window& c,
     Window part;
     part.theta_min = part.phi_min = std::numeric_limits<double>::infinity();
     part.theta_max = part.phi_max = -std::numeric_limits<double>::infinity();
-    for (const auto v : c.evidence) {
+    std::uint8_t reach_reasons = 0;
+    for (std::size_t i = 0; i < all.size(); ++i) {
+      const auto v = all[i];
       const Eigen::Vector2d& a = angles[v];
-      // The margin box about a reaches into the part by more than a touch (rounding
-      // of the margins along a shared border).
+      const bool own = i < c.evidence.size() && owner(a) == k;
+      // Otherwise, the margin box about a reaches into the part by more than a touch
+      // (rounding of the margins along a shared border).
       const double reach = margin - kTouch;
-      if (!(a.x() + reach > lim.theta_min && a.x() - reach < lim.theta_max &&
-            a.y() + reach > lim.phi_min && a.y() - reach < lim.phi_max))
+      if (!own && !(a.x() + reach > lim.theta_min && a.x() - reach < lim.theta_max &&
+                    a.y() + reach > lim.phi_min && a.y() - reach < lim.phi_max))
         continue;
       part.theta_min = std::min(part.theta_min, a.x());
       part.theta_max = std::max(part.theta_max, a.x());
       part.phi_min = std::min(part.phi_min, a.y());
       part.phi_max = std::max(part.phi_max, a.y());
-      part.reasons |= kept[v] & c.reasons;
-      part.evidence.push_back(v);
+      if (own) {
+        part.reasons |= kept[v] & c.reasons;
+        part.evidence.push_back(v);
+      } else {
+        reach_reasons |= kept[v] & c.reasons;
+        part.reach.push_back(v);
+      }
     }
-    if (part.evidence.empty())
+    if (part.evidence.empty() && part.reach.empty())
       continue;
     growWithin(part, margin, p, lim);
     if (part.reasons == 0)
-      part.reasons = c.reasons;
+      part.reasons = reach_reasons != 0 ? reach_reasons : c.reasons;
     if (part.width() > kTouch && part.height() > kTouch)
       out.push_back(std::move(part));
   }
@@ -1056,9 +1145,23 @@ computeRegionsOfInterest(const SegmentationResult& result,
       return false;
     }
   std::vector<Eigen::Vector2d> angles(nv);
-  for (std::size_t v = 0; v < nv; ++v)
+  for (std::size_t v = 0; v < nv; ++v) {
     angles[v] = Eigen::Vector2d(tri.vertex_angles[v][0], tri.vertex_angles[v][1]) *
                 tri.angle_quantization;
+    // Angles of a view: within [-pi, pi] (a quantization far too coarse for its
+    // quantized angles, e.g. 1e304, is not a triangulation of directions).
+    if (!(std::abs(angles[v].x()) <= M_PI + 1e-9 &&
+          std::abs(angles[v].y()) <= M_PI + 1e-9)) {
+      PCL_ERROR("[pcl::selective_seg::computeRegionsOfInterest] vertex %zu has angles "
+                "(%g, %g) outside [-pi, pi]: the quantized angles do not fit the angle "
+                "quantization %g\n",
+                v,
+                angles[v].x(),
+                angles[v].y(),
+                q);
+      return false;
+    }
+  }
   const std::vector<double> spacing = vertexSpacing(tri, angles);
   std::vector<double> strength;
   const std::vector<std::uint8_t> kinds =
@@ -1095,12 +1198,22 @@ computeRegionsOfInterest(const SegmentationResult& result,
     r.phi_max = w.phi_max;
     r.reasons = w.reasons;
     r.num_evidence = ev.size();
+    // A part that only the margins of evidence beside it reach: the spacing there.
+    if (ev.empty())
+      for (const auto v : w.reach)
+        local.push_back(spacing[v]);
     r.current_step = median(local);
     r.suggested_step =
         p.target_step > 0.0 ? p.target_step : r.current_step / p.refinement_factor;
     if (!(r.suggested_step > 0.0) ||
         r.current_step < p.min_refinement * r.suggested_step)
       return false;
+    // Such a part narrower than a step of the finer scan adds no ray that the scan of
+    // the window beside it does not come within a step of.
+    if (ev.empty() && (w.width() < r.suggested_step || w.height() < r.suggested_step)) {
+      ++st.thin_parts;
+      return false;
+    }
     const double area = w.area();
     r.solid_angle = windowSolidAngle(
         r.theta_min, r.theta_max, r.phi_min, r.phi_max, tri.projection);
@@ -1148,8 +1261,9 @@ computeRegionsOfInterest(const SegmentationResult& result,
   std::vector<std::size_t> queue;
   const auto offer = [&](Window&& w, double cap) {
     RegionOfInterest r;
+    const std::size_t thin = st.thin_parts;
     if (!evaluate(w, r)) {
-      ++st.already_fine;
+      st.already_fine += st.thin_parts == thin;
       return;
     }
     r.priority = std::min(r.priority, cap);
@@ -1160,6 +1274,12 @@ computeRegionsOfInterest(const SegmentationResult& result,
   for (auto& w : windows)
     offer(std::move(w), std::numeric_limits<double>::infinity());
   std::vector<std::size_t> selected;
+  // Cells as large as the largest candidate (parts are smaller than their windows):
+  // a window lies in at most four of them.
+  double largest = 0.0;
+  for (const auto& c : pool)
+    largest = std::max({largest, c.window.width(), c.window.height()});
+  WindowGrid taken(largest > 0.0 ? largest : 1.0);
   while (!queue.empty()) {
     std::pop_heap(queue.begin(), queue.end(), later);
     const std::size_t i = queue.back();
@@ -1168,17 +1288,20 @@ computeRegionsOfInterest(const SegmentationResult& result,
     // With disjoint windows, one that overlaps a window taken before it is cut around
     // that window, and its parts are candidates again.
     if (p.disjoint_windows) {
-      const auto hit =
-          std::find_if(selected.begin(), selected.end(), [&](std::size_t k) {
-            return overlapArea(pool[i].window, pool[k].window) > 0.0;
-          });
-      if (hit != selected.end()) {
+      // The first window taken that it overlaps.
+      std::size_t hit = selected.size();
+      taken.forEachNear(pool[i].window, [&](std::size_t order) {
+        if (order < hit &&
+            overlapArea(pool[i].window, pool[selected[order]].window) > 0.0)
+          hit = order;
+      });
+      if (hit != selected.size()) {
         ++st.cut;
         // A part is no more urgent than its window: windows are taken, and listed, in
         // decreasing priority.
         const double cap = r.priority;
-        for (auto& part :
-             cutAround(pool[i].window, pool[*hit].window, angles, kept, spacing, p))
+        for (auto& part : cutAround(
+                 pool[i].window, pool[selected[hit]].window, angles, kept, spacing, p))
           offer(std::move(part), cap); // may reallocate pool: r is not used after this
         continue;
       }
@@ -1193,6 +1316,8 @@ computeRegionsOfInterest(const SegmentationResult& result,
       ++st.over_budget;
       continue;
     }
+    if (p.disjoint_windows)
+      taken.add(pool[i].window, selected.size());
     selected.push_back(i);
     const std::size_t most = std::numeric_limits<std::size_t>::max();
     st.selected_points = r.estimated_points <= most - st.selected_points

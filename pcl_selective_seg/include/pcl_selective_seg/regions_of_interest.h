@@ -112,7 +112,8 @@ struct PCL_EXPORTS RegionOfInterestParameters {
    * [1e-9, pi]. */
   double max_window_size = 0.05;
   /** \brief Windows smaller than this in an angle are widened to it, about their
-   * centre [rad]. Valid: [0, max_window_size]. */
+   * centre, moved inside the view (or, for a part of a cut window, the part) where it
+   * leaves room [rad]. Valid: [0, max_window_size]. */
   double min_window_size = 0.0;
   /** \brief Margin added around the evidence [rad], besides margin_spacings.
    * Valid: >= 0, finite. */
@@ -130,10 +131,14 @@ struct PCL_EXPORTS RegionOfInterestParameters {
    * before it is cut into the parts of it left and right of that window (over its
    * whole height) and below and above it (over their common width). Each part keeps
    * the evidence inside it (evidence inside the window taken is that window's), is
-   * fitted again to it plus margins within the part, evaluated again (steps,
-   * priority, estimates, box) and offered again; parts without evidence, or already
-   * fine, are dropped. false: windows that do not merge may overlap, and the budget
-   * counts an overlap once for each window that holds it. */
+   * fitted again to it and to the evidence whose margin reaches into it, plus
+   * margins, within the part (a margin that the window taken does not cover stays
+   * covered), evaluated again (steps, priority, estimates, box) and offered again. A
+   * part that only margins reach has priority 0 and the spacing of the evidence
+   * beside it, and is dropped when narrower than its suggested step; parts already
+   * fine are dropped too. The parts respect min_window_size where the part leaves
+   * room. false: windows that do not merge may overlap, and the budget counts an
+   * overlap once for each window that holds it. */
   bool disjoint_windows = true;
 
   // --- sampling ---
@@ -221,6 +226,10 @@ struct RegionOfInterestStats {
   std::size_t candidates = 0;             ///< windows after merging
   /** Candidates cut around a window selected before them (disjoint_windows). */
   std::size_t cut = 0;
+  /** Parts of cut candidates dropped because they hold no evidence of their own (only
+   * the margins of evidence beside them reach them) and are narrower than their
+   * suggested step. */
+  std::size_t thin_parts = 0;
   /** Candidates (windows after merging, and parts of cut ones) dropped by
    * min_refinement. */
   std::size_t already_fine = 0;
