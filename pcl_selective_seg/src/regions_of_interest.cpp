@@ -1148,13 +1148,14 @@ computeRegionsOfInterest(const SegmentationResult& result,
   for (std::size_t v = 0; v < nv; ++v) {
     angles[v] = Eigen::Vector2d(tri.vertex_angles[v][0], tri.vertex_angles[v][1]) *
                 tri.angle_quantization;
-    // Angles of a view: within [-pi, pi] (a quantization far too coarse for its
-    // quantized angles, e.g. 1e304, is not a triangulation of directions).
-    if (!(std::abs(angles[v].x()) <= M_PI + 1e-9 &&
-          std::abs(angles[v].y()) <= M_PI + 1e-9)) {
+    // Angles of a view: within [-pi, pi] up to the rounding to a quantum (a panorama's
+    // azimuth near the seam rounds up to half a quantum beyond pi; a quantization far
+    // too coarse for its quantized angles, e.g. 1e304, is not a triangulation of
+    // directions).
+    if (!(std::abs(angles[v].x()) <= M_PI + q && std::abs(angles[v].y()) <= M_PI + q)) {
       PCL_ERROR("[pcl::selective_seg::computeRegionsOfInterest] vertex %zu has angles "
-                "(%g, %g) outside [-pi, pi]: the quantized angles do not fit the angle "
-                "quantization %g\n",
+                "(%g, %g) outside [-pi, pi] by more than a quantum: the quantized angles "
+                "do not fit the angle quantization %g\n",
                 v,
                 angles[v].x(),
                 angles[v].y(),
