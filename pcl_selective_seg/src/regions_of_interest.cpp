@@ -103,6 +103,22 @@ struct Window {
   double width() const { return theta_max - theta_min; }
   double height() const { return phi_max - phi_min; }
   double area() const { return width() * height(); }
+  /** A window holding nothing yet: the first include() sets its bounds. */
+  static Window none()
+  {
+    Window w;
+    w.theta_min = w.phi_min = std::numeric_limits<double>::infinity();
+    w.theta_max = w.phi_max = -std::numeric_limits<double>::infinity();
+    return w;
+  }
+  /** Grows the bounds to hold the angles \a a. */
+  void include(const Eigen::Vector2d& a)
+  {
+    theta_min = std::min(theta_min, a.x());
+    theta_max = std::max(theta_max, a.x());
+    phi_min = std::min(phi_min, a.y());
+    phi_max = std::max(phi_max, a.y());
+  }
 };
 
 double
@@ -560,6 +576,7 @@ makeTileWindows(const SphericalTriangulation& tri,
   // set's root, its smallest member, is its smallest vertex).
   std::vector<std::int32_t> slot(nv, -1);
   std::vector<pcl::index_t> members;
+  const Window view = viewLimits(tri);
   for (const std::uint8_t kind : {kTransition, kSmallSegment, kSparse}) {
     members.clear();
     for (std::size_t v = 0; v < nv; ++v)
@@ -605,21 +622,12 @@ makeTileWindows(const SphericalTriangulation& tri,
           static_cast<std::int64_t>(std::floor(tile.y()))};
       const auto [it, fresh] = group_of.emplace(key, groups.size());
       if (fresh) {
-        Group g;
-        g.key = key;
-        g.window.theta_min = g.window.phi_min = std::numeric_limits<double>::infinity();
-        g.window.theta_max = g.window.phi_max =
-            -std::numeric_limits<double>::infinity();
-        g.window.reasons = kind;
-        groups.push_back(std::move(g));
+        groups.push_back({key, Window::none(), {}});
+        groups.back().window.reasons = kind;
       }
       Group& g = groups[it->second];
-      Window& w = g.window;
-      w.theta_min = std::min(w.theta_min, angles[v].x());
-      w.theta_max = std::max(w.theta_max, angles[v].x());
-      w.phi_min = std::min(w.phi_min, angles[v].y());
-      w.phi_max = std::max(w.phi_max, angles[v].y());
-      w.evidence.push_back(static_cast<pcl::index_t>(v));
+      g.window.include(angles[v]);
+      g.window.evidence.push_back(static_cast<pcl::index_t>(v));
       g.spacing.push_back(spacing[v]);
     }
     std::sort(groups.begin(), groups.end(), [](const Group& a, const Group& b) {
@@ -627,10 +635,8 @@ makeTileWindows(const SphericalTriangulation& tri,
     });
     for (auto& g : groups) {
       Window& w = g.window;
-      growWithin(w,
-                 p.margin + p.margin_spacings * median(std::move(g.spacing)),
-                 p,
-                 viewLimits(tri));
+      growWithin(
+          w, p.margin + p.margin_spacings * median(std::move(g.spacing)), p, view);
       if (w.width() > 0.0 && w.height() > 0.0)
         windows.push_back(std::move(w));
     }
@@ -819,8 +825,9 @@ public:
 private:
   template <typename F> void forEachCell(const Window& w, F f) const
   {
-    // Angles lie within [-pi, pi] and cells are at least 1e-9 rad: the cell numbers
-    // fit 32 bits.
+    // Cells are as large as the largest window: a window spans at most two along each
+    // axis. Cell numbers beyond 32 bits wrap in the key, which only puts far cells'
+    // windows in one list (each is compared exactly).
     const auto at = [this](double x) {
       return static_cast<std::int64_t>(std::floor(x / cell_));
     };
@@ -878,29 +885,24 @@ cutAround(const Window& c,
       return 3;
     return -1;
   };
+  // Otherwise, the margin box about a vertex must reach into a part by more than a
+  // touch (rounding of the margins along a shared border).
+  const double reach = margin - kTouch;
   std::vector<Window> out;
   for (int k = 0; k < 4; ++k) {
     const Window& lim = limits[k];
     if (!(lim.width() > 0.0 && lim.height() > 0.0))
       continue;
-    Window part;
-    part.theta_min = part.phi_min = std::numeric_limits<double>::infinity();
-    part.theta_max = part.phi_max = -std::numeric_limits<double>::infinity();
+    Window part = Window::none();
     std::uint8_t reach_reasons = 0;
     for (std::size_t i = 0; i < all.size(); ++i) {
       const auto v = all[i];
       const Eigen::Vector2d& a = angles[v];
       const bool own = i < c.evidence.size() && owner(a) == k;
-      // Otherwise, the margin box about a reaches into the part by more than a touch
-      // (rounding of the margins along a shared border).
-      const double reach = margin - kTouch;
       if (!own && !(a.x() + reach > lim.theta_min && a.x() - reach < lim.theta_max &&
                     a.y() + reach > lim.phi_min && a.y() - reach < lim.phi_max))
         continue;
-      part.theta_min = std::min(part.theta_min, a.x());
-      part.theta_max = std::max(part.theta_max, a.x());
-      part.phi_min = std::min(part.phi_min, a.y());
-      part.phi_max = std::max(part.phi_max, a.y());
+      part.include(a);
       if (own) {
         part.reasons |= kept[v] & c.reasons;
         part.evidence.push_back(v);
@@ -1178,8 +1180,10 @@ computeRegionsOfInterest(const SegmentationResult& result,
   st.candidates = windows.size();
 
   const VertexGrid grid(angles);
-  // A window as a region: steps, priority, estimates and its box. False when it is
-  // already sampled about as finely as it would be (min_refinement).
+  // A window as a region: steps, priority, estimates and its box; or why it is
+  // dropped: already sampled about as finely as it would be (min_refinement), or a
+  // part holding no evidence of its own narrower than a step.
+  enum class Fate { Kept, AlreadyFine, Thin };
   const auto evaluate = [&](Window& w, RegionOfInterest& r) {
     auto& ev = w.evidence;
     std::sort(ev.begin(), ev.end());
@@ -1208,13 +1212,11 @@ computeRegionsOfInterest(const SegmentationResult& result,
         p.target_step > 0.0 ? p.target_step : r.current_step / p.refinement_factor;
     if (!(r.suggested_step > 0.0) ||
         r.current_step < p.min_refinement * r.suggested_step)
-      return false;
+      return Fate::AlreadyFine;
     // Such a part narrower than a step of the finer scan adds no ray that the scan of
     // the window beside it does not come within a step of.
-    if (ev.empty() && (w.width() < r.suggested_step || w.height() < r.suggested_step)) {
-      ++st.thin_parts;
-      return false;
-    }
+    if (ev.empty() && (w.width() < r.suggested_step || w.height() < r.suggested_step))
+      return Fate::Thin;
     const double area = w.area();
     r.solid_angle = windowSolidAngle(
         r.theta_min, r.theta_max, r.phi_min, r.phi_max, tri.projection);
@@ -1241,7 +1243,7 @@ computeRegionsOfInterest(const SegmentationResult& result,
     // spacing^2), times the share of new samples a scan at the suggested step brings.
     r.priority =
         weighted / std::max(area, covered) * (1.0 - r.suggested_step / r.current_step);
-    return true;
+    return Fate::Kept;
   };
 
   // Candidates in priority order, then by their angles (and, for a tie in all of
@@ -1262,9 +1264,9 @@ computeRegionsOfInterest(const SegmentationResult& result,
   std::vector<std::size_t> queue;
   const auto offer = [&](Window&& w, double cap) {
     RegionOfInterest r;
-    const std::size_t thin = st.thin_parts;
-    if (!evaluate(w, r)) {
-      st.already_fine += st.thin_parts == thin;
+    const Fate fate = evaluate(w, r);
+    if (fate != Fate::Kept) {
+      ++(fate == Fate::Thin ? st.thin_parts : st.already_fine);
       return;
     }
     r.priority = std::min(r.priority, cap);
