@@ -1105,6 +1105,67 @@ TEST_F(CubeRegions, ShuffledCloudGivesTheSameWindows)
   }
 }
 
+// The vertices inside a window are looked up on a grid that spans the bulk of the
+// angles; far outliers lie in its clamped border cells. Every window's vertex count and
+// box must still be those of all vertices inside it (a pass over every vertex).
+TEST_F(CubeRegions, FarOutliersKeepEveryWindowsVertices)
+{
+  auto cloud = pcl::make_shared<pcl::PointCloud<pcl::PointXYZL>>(*cloud_);
+  for (const auto& [x, y] : {std::pair<float, float>{8.f, 0.f},
+                             {-8.f, 0.3f},
+                             {0.f, 8.f},
+                             {0.2f, -8.f},
+                             {8.f, 8.f}}) {
+    pcl::PointXYZL p;
+    p.x = x;
+    p.y = y;
+    p.z = 1.f; // about 83 deg off the axis: far beyond the cube's view
+    p.label = 0;
+    cloud->push_back(p);
+  }
+  cloud->width = static_cast<std::uint32_t>(cloud->size());
+  cloud->height = 1;
+  SelectiveSegmentation<pcl::PointXYZL> seg;
+  seg.setInputCloud(cloud);
+  std::vector<pcl::PointIndices> clusters;
+  ASSERT_TRUE(seg.extract(clusters));
+  RegionOfInterestParameters p = noBudget();
+  p.max_window_size = 0.02; // many small windows, the outliers' own among them
+  std::vector<RegionOfInterest> regions;
+  ASSERT_TRUE(computeRegionsOfInterest(seg, p, regions));
+  ASSERT_GT(regions.size(), 20u);
+  const SphericalTriangulation& tri = seg.getTriangulation();
+  const Eigen::Affine3f pose = seg.getSensorPose();
+  std::size_t with_outlier = 0;
+  for (const auto& r : regions) {
+    std::size_t inside = 0;
+    bool outlier = false;
+    Eigen::Vector3f lo = Eigen::Vector3f::Constant(std::numeric_limits<float>::max());
+    Eigen::Vector3f hi = -lo;
+    for (std::size_t v = 0; v < tri.vertex_angles.size(); ++v) {
+      const double theta = tri.vertex_angles[v][0] * tri.angle_quantization;
+      const double phi = tri.vertex_angles[v][1] * tri.angle_quantization;
+      if (theta < r.theta_min || theta > r.theta_max || phi < r.phi_min ||
+          phi > r.phi_max)
+        continue;
+      ++inside;
+      outlier = outlier || std::abs(theta) > 1.0 || std::abs(phi) > 1.0;
+      const Eigen::Vector3f x =
+          (pose.cast<double>() * tri.vertex_positions[v].cast<double>()).cast<float>();
+      lo = lo.cwiseMin(x);
+      hi = hi.cwiseMax(x);
+    }
+    with_outlier += outlier;
+    EXPECT_EQ(r.num_points, inside);
+    if (inside > 0) {
+      EXPECT_EQ(r.box_min, lo);
+      EXPECT_EQ(r.box_max, hi);
+    }
+  }
+  // The outliers are sparse evidence of their own: their windows are among these.
+  EXPECT_GT(with_outlier, 0u);
+}
+
 // Found by review (session 24): the template overload read the cloud's own pose after
 // setSensorPose() had overridden it (boxes in the wrong frame), and a result paired
 // with the triangulation of a shuffled copy of its cloud was accepted.

@@ -718,15 +718,34 @@ public:
       : angles_(angles)
   {
     const std::size_t n = angles.size();
-    lo_ = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
-    Eigen::Vector2d hi = -lo_;
-    for (const auto& a : angles) {
-      lo_ = lo_.cwiseMin(a);
-      hi = hi.cwiseMax(a);
+    // The grid spans the angles between the 0.1% and 99.9% quantiles of each axis (of
+    // a sample of at most 2^16 vertices), not their whole extent: a few far outliers
+    // would otherwise widen every cell and crowd the scan's vertices into a few of
+    // them. Vertices beyond go to the border cells (cell() clamps).
+    lo_ = hi_ = Eigen::Vector2d::Zero();
+    if (n > 0) {
+      const std::size_t stride = std::max<std::size_t>(1, n >> 16);
+      std::vector<double> sample;
+      sample.reserve(n / stride + 1);
+      for (int axis = 0; axis < 2; ++axis) {
+        sample.clear();
+        for (std::size_t v = 0; v < n; v += stride)
+          sample.push_back(angles[v][axis]);
+        const auto at = [&sample](double q) {
+          const auto k = static_cast<std::ptrdiff_t>(
+              std::floor(q * static_cast<double>(sample.size() - 1)));
+          std::nth_element(sample.begin(), sample.begin() + k, sample.end());
+          return sample[static_cast<std::size_t>(k)];
+        };
+        lo_[axis] = at(0.001);
+        hi_[axis] = at(0.999);
+        if (!(hi_[axis] > lo_[axis])) { // most vertices on one line: the whole extent
+          lo_[axis] = *std::min_element(sample.begin(), sample.end());
+          hi_[axis] = *std::max_element(sample.begin(), sample.end());
+        }
+      }
     }
-    if (n == 0)
-      lo_ = hi = Eigen::Vector2d::Zero();
-    Eigen::Vector2d extent = hi - lo_;
+    Eigen::Vector2d extent = hi_ - lo_;
     if (!extent.allFinite()) // not for a caller's angles (checked), but never NaN cells
       lo_ = extent = Eigen::Vector2d::Zero();
     const double cells = std::max(1.0, static_cast<double>(n) / 4.0);
@@ -789,7 +808,7 @@ private:
   }
 
   const std::vector<Eigen::Vector2d>& angles_;
-  Eigen::Vector2d lo_, scale_;
+  Eigen::Vector2d lo_, hi_, scale_;
   std::array<std::int64_t, 2> size_{{1, 1}};
   std::vector<std::size_t> start_;    ///< first entry of each cell in vertices_
   std::vector<std::size_t> vertices_; ///< by cell, in increasing number in each
