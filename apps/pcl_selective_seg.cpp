@@ -370,8 +370,10 @@ writeOutputs(const Options& opt,
   if (!opt.roi_json.empty()) {
     TicToc roi_timer;
     roi_timer.tic();
+    pcl::selective_seg::RegionOfInterestParameters roi = opt.roi;
+    roi.num_threads = opt.params.num_threads; // -threads
     if (!pcl::selective_seg::computeRegionsOfInterest(
-            r, seg.getTriangulation(), pose, opt.roi, regions, &stats)) {
+            r, seg.getTriangulation(), pose, roi, regions, &stats)) {
       print_error("Computing the regions of interest failed (reason above).\n");
       return false;
     }

@@ -341,10 +341,12 @@ segment(const Options& opt, Scene& scene)
   scene.regions_pose = scene.sensor_pose;
   if (opt.roi) {
     pcl::selective_seg::RegionOfInterestStats stats;
+    pcl::selective_seg::RegionOfInterestParameters roi_params = opt.roi_params;
+    roi_params.num_threads = opt.params.num_threads; // -threads
     if (!pcl::selective_seg::computeRegionsOfInterest(scene.result,
                                                       seg.getTriangulation(),
                                                       scene.sensor_pose,
-                                                      opt.roi_params,
+                                                      roi_params,
                                                       scene.regions,
                                                       &stats)) {
       print_error("Computing the regions of interest failed (reason above).\n");

@@ -219,6 +219,8 @@ TEST(RegionsOfInterest, EveryBadParameterIsNamed)
       {"sparse_weight", [](P& p) { p.sparse_weight = -0.5; }},
       {"max_solid_angle", [](P& p) { p.max_solid_angle = -1.0; }},
       {"sample_yield", [](P& p) { p.sample_yield = 0.0; }},
+      {"num_threads", [](P& p) { p.num_threads = -1; }},
+      {"num_threads", [](P& p) { p.num_threads = 1025; }},
   };
   for (const auto& c : cases) {
     P p;
@@ -235,8 +237,64 @@ TEST(RegionsOfInterest, EveryBadParameterIsNamed)
   p.min_window_size = p.max_window_size;
   p.min_refinement = 1.0;
   p.sample_yield = 1.0;
+  p.num_threads = 1024;
   std::string why;
   EXPECT_TRUE(p.validate(&why)) << why;
+}
+
+// The passes over vertices, triangles and candidates run on the threads from 16,384
+// items: a door scan of about 60,000 points gives the same regions, field for field,
+// on 1, 2 and 3 threads, with and without disjoint windows.
+TEST(RegionsOfInterest, SameRegionsForAnyThreadCount)
+{
+  const auto setup = sim::makeDoorScene(1.3);
+  sim::SensorSimulator simulator;
+  ASSERT_TRUE(simulator.setParameters(setup.sensor));
+  auto cloud = pcl::make_shared<pcl::PointCloud<pcl::PointXYZL>>();
+  ASSERT_TRUE(simulator.simulate(setup.scene, *cloud));
+  ASSERT_GT(cloud->size(), 40000u);
+  SelectiveSegmentation<pcl::PointXYZL> seg;
+  seg.setInputCloud(cloud);
+  std::vector<pcl::PointIndices> clusters;
+  ASSERT_TRUE(seg.extract(clusters));
+  for (const bool disjoint : {true, false}) {
+    std::vector<RegionOfInterest> reference;
+    RegionOfInterestStats reference_stats;
+    for (const int threads : {1, 2, 3}) {
+      RegionOfInterestParameters p;
+      p.disjoint_windows = disjoint;
+      p.num_threads = threads;
+      std::vector<RegionOfInterest> regions;
+      RegionOfInterestStats stats;
+      ASSERT_TRUE(computeRegionsOfInterest(seg, p, regions, &stats));
+      if (threads == 1) {
+        ASSERT_GT(regions.size(), 50u);
+        reference = regions;
+        reference_stats = stats;
+        continue;
+      }
+      ASSERT_EQ(regions.size(), reference.size()) << threads << " threads";
+      for (std::size_t i = 0; i < regions.size(); ++i) {
+        const RegionOfInterest& a = regions[i];
+        const RegionOfInterest& b = reference[i];
+        EXPECT_TRUE(a.theta_min == b.theta_min && a.theta_max == b.theta_max &&
+                    a.phi_min == b.phi_min && a.phi_max == b.phi_max &&
+                    a.box_min == b.box_min && a.box_max == b.box_max &&
+                    a.priority == b.priority && a.suggested_step == b.suggested_step &&
+                    a.current_step == b.current_step && a.reasons == b.reasons &&
+                    a.num_evidence == b.num_evidence && a.num_points == b.num_points &&
+                    a.estimated_points == b.estimated_points &&
+                    a.solid_angle == b.solid_angle)
+            << "region " << i << ", " << threads << " threads";
+      }
+      EXPECT_EQ(stats.transition_vertices, reference_stats.transition_vertices);
+      EXPECT_EQ(stats.sparse_vertices, reference_stats.sparse_vertices);
+      EXPECT_EQ(stats.candidates, reference_stats.candidates);
+      EXPECT_EQ(stats.cut, reference_stats.cut);
+      EXPECT_EQ(stats.thin_parts, reference_stats.thin_parts);
+      EXPECT_EQ(stats.already_fine, reference_stats.already_fine);
+    }
+  }
 }
 
 TEST(RegionsOfInterest, EmptyAndMismatchedInput)

@@ -300,12 +300,15 @@ TEST_F(Tool, SummaryRecordsEveryParameter)
 TEST_F(Tool, ThreadCountKeepsTheOutput)
 {
   const std::string in = "'" + scan + "' -ignore_viewpoint -o ";
-  ASSERT_EQ(run(in + out("one.pcd") + " -threads 1"), 0);
-  ASSERT_EQ(run(in + out("two.pcd") + " -threads 2"), 0);
+  ASSERT_EQ(run(in + out("one.pcd") + " -threads 1 -roi_json " + out("one.json")), 0);
+  ASSERT_EQ(run(in + out("two.pcd") + " -threads 2 -roi_json " + out("two.json")), 0);
   const std::string a = fileBytes(out("one.pcd"));
   const std::string b = fileBytes(out("two.pcd"));
   EXPECT_GT(a.size(), 1000u);
   EXPECT_EQ(a, b);
+  // The regions of interest too (their passes run on the threads).
+  EXPECT_GT(fileBytes(out("one.json")).size(), 1000u);
+  EXPECT_EQ(fileBytes(out("one.json")), fileBytes(out("two.json")));
 }
 
 TEST_F(Tool, KeepingFreedMemoryKeepsTheOutput)

@@ -17,6 +17,10 @@
 #include <tuple>
 #include <unordered_map>
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 #include "parameter_checks.h"
 
 namespace pcl {
@@ -29,6 +33,28 @@ constexpr double kHalfPi = 0.5 * M_PI;
 constexpr double kEdgeGuard = 1e-6;
 /** Margins that overlap a window by less than this merely touch it [rad]. */
 constexpr double kTouch = 1e-9;
+/** Passes over fewer items than this run on the calling thread (a team costs more). */
+constexpr std::ptrdiff_t kParallelFrom = 16384;
+
+/** The smallest i in [0, n) with bad(i), or n: on \a threads threads, the same
+ * answer as a sequential search. bad(i) is called for every i when none is bad. */
+template <typename Bad>
+std::size_t
+firstWhere(std::size_t n, int threads, Bad bad)
+{
+  std::size_t first = n;
+  const auto count = static_cast<std::ptrdiff_t>(n);
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(threads) schedule(static)                         \
+    reduction(min                                                                      \
+              : first) if (count >= kParallelFrom)
+#endif
+  for (std::ptrdiff_t i = 0; i < count; ++i)
+    if (static_cast<std::size_t>(i) < first && bad(static_cast<std::size_t>(i)))
+      first = static_cast<std::size_t>(i);
+  (void)threads;
+  return first;
+}
 
 /** The step from b to a in (theta, phi) [rad]; with the panoramic projection theta's
  * difference is taken the short way round the seam, into (-pi, pi]. */
@@ -184,7 +210,8 @@ areaMedian(std::vector<double> v)
 /** Median angular length of the mesh edges at each vertex [rad] (0 when isolated). */
 std::vector<double>
 vertexSpacing(const SphericalTriangulation& tri,
-              const std::vector<Eigen::Vector2d>& angles)
+              const std::vector<Eigen::Vector2d>& angles,
+              int threads)
 {
   const std::size_t nv = angles.size();
   // The triangles at each vertex (4-byte ids: a list of every edge length at every
@@ -204,14 +231,20 @@ vertexSpacing(const SphericalTriangulation& tri,
   // The median of the lengths of the two edges at the vertex of each of its triangles
   // (at each corner that is the vertex: a triangle listed twice in a row has it twice).
   std::vector<double> spacing(nv, 0.0);
-  std::vector<double> lengths;
   const auto length = [&](pcl::index_t a, pcl::index_t b) {
     return angleStep(angles[static_cast<std::size_t>(a)],
                      angles[static_cast<std::size_t>(b)],
                      tri)
         .norm();
   };
-  for (std::size_t v = 0; v < nv; ++v) {
+  const auto count = static_cast<std::ptrdiff_t>(nv);
+  std::vector<double> lengths;
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(threads) schedule(static)                         \
+    firstprivate(lengths) if (count >= kParallelFrom)
+#endif
+  for (std::ptrdiff_t iv = 0; iv < count; ++iv) {
+    const auto v = static_cast<std::size_t>(iv);
     lengths.clear();
     for (std::uint32_t i = start[v]; i < start[v + 1]; ++i) {
       if (i > start[v] && at[i] == at[i - 1])
@@ -259,6 +292,7 @@ markLeafEvidence(const SegmentationResult& result,
                  const SphericalTriangulation& tri,
                  const Eigen::Affine3d& cloud_to_sensor,
                  double sigma_threshold,
+                 int threads,
                  std::vector<std::uint8_t>& kinds)
 {
   if (!(sigma_threshold > 0.0) || result.leaves.empty())
@@ -291,13 +325,21 @@ markLeafEvidence(const SegmentationResult& result,
   if (cells.empty())
     return;
   std::sort(cells.begin(), cells.end());
-  for (std::size_t v = 0; v < tri.vertex_positions.size(); ++v)
+  const auto count = static_cast<std::ptrdiff_t>(tri.vertex_positions.size());
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(threads)                                          \
+    schedule(static) if (count >= kParallelFrom)
+#endif
+  for (std::ptrdiff_t iv = 0; iv < count; ++iv) {
+    const auto v = static_cast<std::size_t>(iv);
     if (tri.vertex_positions[v].allFinite() &&
         std::binary_search(
             cells.begin(),
             cells.end(),
             cellKey(tri.vertex_positions[v].cast<double>(), origin, size)))
       kinds[v] |= kTransition;
+  }
+  (void)threads;
 }
 
 /** Corners of triangle \a t in the sensor frame. */
@@ -423,6 +465,7 @@ findEvidence(const SegmentationResult& result,
              const std::vector<Eigen::Vector2d>& angles,
              const std::vector<double>& spacing,
              const RegionOfInterestParameters& p,
+             int threads,
              std::vector<double>& transition_strength)
 {
   const std::size_t nv = tri.vertex_point.size();
@@ -434,21 +477,35 @@ findEvidence(const SegmentationResult& result,
     transition_strength[v] = std::max(transition_strength[v], weight);
   };
   const std::vector<double> cones = sideCones(result, tri, p);
-  for (std::size_t t = 0; t < tri.triangles.size(); ++t) {
+  // What each triangle is evidence of (on the threads), then the marks (a maximum and
+  // bits: in any order the same).
+  enum : std::uint8_t { kNone, kTransitionTriangle, kValidEdgeTriangle };
+  std::vector<std::uint8_t> evidence(tri.triangles.size(), kNone);
+  const auto nt = static_cast<std::ptrdiff_t>(tri.triangles.size());
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(threads)                                          \
+    schedule(dynamic, 4096) if (nt >= kParallelFrom)
+#endif
+  for (std::ptrdiff_t it = 0; it < nt; ++it) {
+    const auto t = static_cast<std::size_t>(it);
     const auto c = result.mesh.classes[t];
     if ((c == TriangleClass::InvalidEdge || c == TriangleClass::ValidEdge) &&
         !twoSurfaces(result, tri, t, p, cones))
       continue;
     if ((p.use_invalid_edges && c == TriangleClass::InvalidEdge) ||
         (p.use_edge_on && edgeOn(tri, t, p, false)))
-      for (const auto v : tri.triangles[t])
-        mark(static_cast<std::size_t>(v), p.transition_weight);
+      evidence[t] = kTransitionTriangle;
     else if (p.use_valid_edges && c == TriangleClass::ValidEdge)
-      for (const auto v : tri.triangles[t])
-        mark(static_cast<std::size_t>(v), p.valid_edge_weight);
+      evidence[t] = kValidEdgeTriangle;
   }
+  for (std::size_t t = 0; t < tri.triangles.size(); ++t)
+    if (evidence[t] != kNone)
+      for (const auto v : tri.triangles[t])
+        mark(static_cast<std::size_t>(v),
+             evidence[t] == kTransitionTriangle ? p.transition_weight
+                                                : p.valid_edge_weight);
   std::vector<std::uint8_t> leaf(nv, 0);
-  markLeafEvidence(result, tri, cloud_to_sensor, p.leaf_sigma_threshold, leaf);
+  markLeafEvidence(result, tri, cloud_to_sensor, p.leaf_sigma_threshold, threads, leaf);
   for (std::size_t v = 0; v < nv; ++v)
     if (leaf[v])
       mark(v, p.leaf_weight);
@@ -1031,6 +1088,8 @@ RegionOfInterestParameters::validate(std::string* why) const
         why, "max_solid_angle", max_solid_angle, "[0, inf) [sr], 0 = no limit");
   if (!(sample_yield > 0.0 && sample_yield <= 1.0))
     return reject(why, "sample_yield", sample_yield, "(0, 1]");
+  if (!(num_threads >= 0 && num_threads <= 1024))
+    return reject(why, "num_threads", num_threads, "[0, 1024], 0 = automatic");
   return true;
 }
 
@@ -1100,14 +1159,21 @@ computeRegionsOfInterest(const SegmentationResult& result,
               tri.triangles.size());
     return false;
   }
-  for (std::size_t v = 0; v < nv; ++v)
-    if (tri.vertex_point[v] < 0 ||
-        static_cast<std::size_t>(tri.vertex_point[v]) >= result.labels.size()) {
-      PCL_ERROR("[pcl::selective_seg::computeRegionsOfInterest] vertex %zu has no "
-                "input point\n",
-                v);
-      return false;
-    }
+  const int threads = detail::threadCount(p.num_threads);
+  if (const std::size_t v =
+          firstWhere(nv,
+                     threads,
+                     [&](std::size_t v) {
+                       return tri.vertex_point[v] < 0 ||
+                              static_cast<std::size_t>(tri.vertex_point[v]) >=
+                                  result.labels.size();
+                     });
+      v < nv) {
+    PCL_ERROR("[pcl::selective_seg::computeRegionsOfInterest] vertex %zu has no "
+              "input point\n",
+              v);
+    return false;
+  }
   if (tri.triangles.size() > std::numeric_limits<std::uint32_t>::max() / 3) {
     PCL_ERROR("[pcl::selective_seg::computeRegionsOfInterest] %zu triangles: at most "
               "(2^32 - 1) / 3 are supported\n",
@@ -1115,26 +1181,35 @@ computeRegionsOfInterest(const SegmentationResult& result,
     return false;
   }
   const auto nt = static_cast<pcl::index_t>(tri.triangles.size());
-  for (std::size_t t = 0; t < tri.triangles.size(); ++t)
+  // Per triangle: 0 fine, 1 a corner or neighbour out of range, 2 a corner that is not
+  // the result's.
+  const auto triangleFault = [&](std::size_t t) {
     for (int k = 0; k < 3; ++k) {
       if (tri.triangles[t][k] < 0 ||
           static_cast<std::size_t>(tri.triangles[t][k]) >= nv ||
-          result.mesh.neighbours[t][k] < -1 || result.mesh.neighbours[t][k] >= nt) {
-        PCL_ERROR(
-            "[pcl::selective_seg::computeRegionsOfInterest] triangle %zu refers to "
-            "a vertex or neighbour out of range\n",
-            t);
-        return false;
-      }
+          result.mesh.neighbours[t][k] < -1 || result.mesh.neighbours[t][k] >= nt)
+        return 1;
       // The result's mesh names each corner by its point: the triangulation's.
-      if (result.mesh.triangles[t][k] != tri.vertex_point[tri.triangles[t][k]]) {
-        PCL_ERROR("[pcl::selective_seg::computeRegionsOfInterest] triangle %zu of the "
-                  "result does not join the triangulation's points (a result of "
-                  "another cloud, or of the same points in another order?)\n",
-                  t);
-        return false;
-      }
+      if (result.mesh.triangles[t][k] != tri.vertex_point[tri.triangles[t][k]])
+        return 2;
     }
+    return 0;
+  };
+  if (const std::size_t t = firstWhere(tri.triangles.size(),
+                                       threads,
+                                       [&](std::size_t t) { return triangleFault(t); });
+      t < tri.triangles.size()) {
+    if (triangleFault(t) == 1)
+      PCL_ERROR("[pcl::selective_seg::computeRegionsOfInterest] triangle %zu refers to "
+                "a vertex or neighbour out of range\n",
+                t);
+    else
+      PCL_ERROR("[pcl::selective_seg::computeRegionsOfInterest] triangle %zu of the "
+                "result does not join the triangulation's points (a result of "
+                "another cloud, or of the same points in another order?)\n",
+                t);
+    return false;
+  }
   if (nv == 0)
     return true;
   const double q = tri.angle_quantization;
@@ -1158,36 +1233,48 @@ computeRegionsOfInterest(const SegmentationResult& result,
   // A vertex's position may overflow float in the sensor frame (a point near float's
   // limit, rotated): the segmentation leaves it without a normal, and here it counts
   // for its angles only (no leaf evidence, no part of a box).
-  for (std::size_t v = 1; v < nv; ++v)
-    if (tri.vertex_angles[v][0] < tri.vertex_angles[v - 1][0]) {
-      PCL_ERROR("[pcl::selective_seg::computeRegionsOfInterest] vertex %zu is out of "
-                "theta order (vertices are numbered in increasing quantized theta)\n",
-                v);
-      return false;
-    }
-  std::vector<Eigen::Vector2d> angles(nv);
-  for (std::size_t v = 0; v < nv; ++v) {
-    angles[v] = Eigen::Vector2d(tri.vertex_angles[v][0], tri.vertex_angles[v][1]) *
-                tri.angle_quantization;
-    // Angles of a view: within [-pi, pi] up to the rounding to a quantum (a panorama's
-    // azimuth near the seam rounds up to half a quantum beyond pi; a quantization far
-    // too coarse for its quantized angles, e.g. 1e304, is not a triangulation of
-    // directions).
-    if (!(std::abs(angles[v].x()) <= M_PI + q && std::abs(angles[v].y()) <= M_PI + q)) {
-      PCL_ERROR("[pcl::selective_seg::computeRegionsOfInterest] vertex %zu has angles "
-                "(%g, %g) outside [-pi, pi] by more than a quantum: the quantized angles "
-                "do not fit the angle quantization %g\n",
-                v,
-                angles[v].x(),
-                angles[v].y(),
-                q);
-      return false;
-    }
+  if (const std::size_t v = firstWhere(nv - 1,
+                                       threads,
+                                       [&](std::size_t v) {
+                                         return tri.vertex_angles[v + 1][0] <
+                                                tri.vertex_angles[v][0];
+                                       }) +
+                            1;
+      v < nv) {
+    PCL_ERROR("[pcl::selective_seg::computeRegionsOfInterest] vertex %zu is out of "
+              "theta order (vertices are numbered in increasing quantized theta)\n",
+              v);
+    return false;
   }
-  const std::vector<double> spacing = vertexSpacing(tri, angles);
+  std::vector<Eigen::Vector2d> angles(nv);
+  const auto angle = [&](std::size_t v) -> Eigen::Vector2d {
+    return Eigen::Vector2d(tri.vertex_angles[v][0], tri.vertex_angles[v][1]) * q;
+  };
+  // Angles of a view: within [-pi, pi] up to the rounding to a quantum (a panorama's
+  // azimuth near the seam rounds up to half a quantum beyond pi; a quantization far
+  // too coarse for its quantized angles, e.g. 1e304, is not a triangulation of
+  // directions).
+  if (const std::size_t v = firstWhere(nv,
+                                       threads,
+                                       [&](std::size_t v) {
+                                         angles[v] = angle(v);
+                                         return !(std::abs(angles[v].x()) <= M_PI + q &&
+                                                  std::abs(angles[v].y()) <= M_PI + q);
+                                       });
+      v < nv) {
+    PCL_ERROR("[pcl::selective_seg::computeRegionsOfInterest] vertex %zu has angles "
+              "(%g, %g) outside [-pi, pi] by more than a quantum: the quantized angles "
+              "do not fit the angle quantization %g\n",
+              v,
+              angles[v].x(),
+              angles[v].y(),
+              q);
+    return false;
+  }
+  const std::vector<double> spacing = vertexSpacing(tri, angles, threads);
   std::vector<double> strength;
   const std::vector<std::uint8_t> kinds =
-      findEvidence(result, tri, to_sensor, angles, spacing, p, strength);
+      findEvidence(result, tri, to_sensor, angles, spacing, p, threads, strength);
   for (const auto k : kinds) {
     st.transition_vertices += (k & kTransition) != 0;
     st.small_segment_vertices += (k & kSmallSegment) != 0;
@@ -1281,9 +1368,7 @@ computeRegionsOfInterest(const SegmentationResult& result,
   // A max-heap on "comes first".
   const auto later = [&before](std::size_t i, std::size_t j) { return before(j, i); };
   std::vector<std::size_t> queue;
-  const auto offer = [&](Window&& w, double cap) {
-    RegionOfInterest r;
-    const Fate fate = evaluate(w, r);
+  const auto take = [&](Window&& w, RegionOfInterest& r, Fate fate, double cap) {
     if (fate != Fate::Kept) {
       ++(fate == Fate::Thin ? st.thin_parts : st.already_fine);
       return;
@@ -1293,8 +1378,28 @@ computeRegionsOfInterest(const SegmentationResult& result,
     queue.push_back(pool.size() - 1);
     std::push_heap(queue.begin(), queue.end(), later);
   };
-  for (auto& w : windows)
-    offer(std::move(w), std::numeric_limits<double>::infinity());
+  const auto offer = [&](Window&& w, double cap) {
+    RegionOfInterest r;
+    const Fate fate = evaluate(w, r);
+    take(std::move(w), r, fate, cap);
+  };
+  {
+    // The candidates are evaluated on the threads (each on its own), then offered in
+    // their order.
+    std::vector<RegionOfInterest> first(windows.size());
+    std::vector<Fate> fates(windows.size());
+    const auto count = static_cast<std::ptrdiff_t>(windows.size());
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 1) if (count >= 64)
+#endif
+    for (std::ptrdiff_t i = 0; i < count; ++i)
+      fates[i] = evaluate(windows[i], first[i]);
+    for (std::size_t i = 0; i < windows.size(); ++i)
+      take(std::move(windows[i]),
+           first[i],
+           fates[i],
+           std::numeric_limits<double>::infinity());
+  }
   std::vector<std::size_t> selected;
   // Cells as large as the largest candidate (parts are smaller than their windows):
   // a window lies in at most four of them.

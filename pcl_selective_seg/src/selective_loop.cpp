@@ -322,6 +322,7 @@ runSelectiveLoop(const SimulationSetup& setup,
         roi.max_window_size = std::min(M_PI, params.window_steps * coarse_step);
       roi.min_window_size = std::min(roi.min_window_size, roi.max_window_size);
       roi.sample_yield = yield;
+      roi.num_threads = params.segmentation.num_threads;
       roi.max_points = std::max<std::size_t>(
           1,
           (params.point_budget - score.points) /

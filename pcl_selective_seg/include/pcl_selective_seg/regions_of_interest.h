@@ -174,6 +174,11 @@ struct PCL_EXPORTS RegionOfInterestParameters {
    * that returns a point (texture, dropouts, misses). Valid: (0, 1]. */
   double sample_yield = 1.0;
 
+  /** \brief Threads for the passes over vertices, triangles and candidate windows;
+   * 0 = automatic (defaultThreads()). The regions are identical for any value. Valid:
+   * [0, 1024]. */
+  int num_threads = 0;
+
   /** \brief Check every parameter.
    * \param[out] why when invalid and non-null: the parameter, its value and its
    *             valid range.
