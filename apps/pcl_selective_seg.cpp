@@ -242,14 +242,11 @@ parseOptions(int argc, char** argv, Options& opt)
   if (!outputsDistinct(opt))
     return kUsageError;
   if (!selseg_apps::parseNumber(argc, argv, "-unit_scale", opt.unit_scale) ||
-      !(opt.unit_scale > 0.0) ||
+      !selseg_apps::unitScaleUsable(opt.unit_scale) ||
       !parseVector(argc, argv, "-sensor_origin", 3, opt.sensor_origin) ||
       !parseVector(argc, argv, "-sensor_orientation", 4, opt.sensor_orientation) ||
-      !orientationUsable(opt.sensor_orientation)) {
-    if (!(opt.unit_scale > 0.0))
-      print_error("Option -unit_scale needs a positive number.\n");
+      !orientationUsable(opt.sensor_orientation))
     return kUsageError;
-  }
   if (!selseg_apps::parseSegmentationOptions(argc, argv, opt.params) ||
       !selseg_apps::parseRegionOptions(argc, argv, opt.roi))
     return kUsageError;

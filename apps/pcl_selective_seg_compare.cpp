@@ -8,8 +8,9 @@
 // the same ground-truth clouds, measure quality and run time, and print a markdown
 // table.
 //
-// Inputs are PCD files with x y z and a ground-truth "label" field (0 = invalid), with
-// the sensor at the origin looking along +z (the simulator's output, the mOSD frames).
+// Inputs are PCD files with x y z and a ground-truth "label" field (0 = invalid), seen
+// from the file's VIEWPOINT (the simulator's output and the mOSD frames: the origin,
+// looking along +z).
 // Exit codes: 0 = success, 1 = runtime error, 2 = usage error.
 
 #include <pcl_selective_seg/segmentation_metrics.h>
@@ -27,7 +28,10 @@
 #include <pcl/segmentation/region_growing.h>
 #include <pcl/segmentation/supervoxel_clustering.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <string>
@@ -81,8 +85,7 @@ runSelective(const Cloud::ConstPtr& cloud,
   pcl::StopWatch watch;
   pcl::selective_seg::SelectiveSegmentation<pcl::PointXYZ> seg;
   seg.setParameters(params);
-  seg.setSensorPose(Eigen::Affine3f::Identity());
-  seg.setInputCloud(cloud);
+  seg.setInputCloud(cloud); // the sensor pose: the file's VIEWPOINT
   std::vector<pcl::PointIndices> clusters;
   r.ok = seg.extract(clusters);
   r.seconds = watch.getTimeSeconds();
@@ -140,6 +143,21 @@ runLccp(const Cloud::ConstPtr& cloud)
   Run r;
   pcl::StopWatch watch;
   const float voxel = 0.01f, seed = 0.04f;
+  // PCL's octree aborts (an assertion in getKeyBitSize) when the cloud spans too many
+  // voxels: beyond 2^24 voxels (168 km) the method is reported as failed.
+  Eigen::Array3f lo = Eigen::Array3f::Constant(std::numeric_limits<float>::max());
+  Eigen::Array3f hi = -lo;
+  for (const auto& p : *cloud)
+    if (pcl::isFinite(p)) {
+      lo = lo.min(p.getArray3fMap());
+      hi = hi.max(p.getArray3fMap());
+    }
+  if (!((hi - lo).maxCoeff() / voxel < static_cast<float>(1 << 24))) {
+    print_warn("Supervoxel+LCCP: the cloud spans more than 2^24 voxels of %g m; "
+               "reported as failed.\n",
+               voxel);
+    return r;
+  }
   pcl::SupervoxelClustering<pcl::PointXYZ> super(voxel, seed);
   super.setUseSingleCameraTransform(false);
   super.setInputCloud(cloud);
@@ -174,6 +192,19 @@ Run
 runMultiPlane(const Cloud::ConstPtr& cloud)
 {
   Run r;
+  // PCL's integral images read past a smaller image with this smoothing size (a
+  // crash): such a cloud is reported as failed.
+  constexpr std::uint32_t kMinSide = 20;
+  if (cloud->width < kMinSide || cloud->height < kMinSide) {
+    print_warn(
+        "OrganizedMultiPlane: the cloud is %u x %u; at least %u x %u are needed; "
+        "reported as failed.\n",
+        cloud->width,
+        cloud->height,
+        kMinSide,
+        kMinSide);
+    return r;
+  }
   pcl::StopWatch watch;
   auto normals = pcl::make_shared<pcl::PointCloud<pcl::Normal>>();
   pcl::IntegralImageNormalEstimation<pcl::PointXYZ, pcl::Normal> ne;
@@ -305,11 +336,18 @@ evaluate(const std::string& path, std::string& table)
     print_error("'%s' holds no point.\n", path.c_str());
     return false;
   }
-  std::size_t finite = 0;
+  std::size_t finite = 0, labeled = 0;
   for (std::size_t i = 0; i < cloud->size(); ++i) {
     finite += pcl::isFinite((*cloud)[i]);
-    if (!std::isfinite((*cloud)[i].z))
-      truth[i] = 0;
+    if (!pcl::isFinite((*cloud)[i]))
+      truth[i] = 0; // a point without a position is in no region
+    labeled += truth[i] != 0;
+  }
+  if (labeled == 0) {
+    print_error("'%s' has no ground-truth label on a finite point (every label is 0, "
+                "the invalid label): give a cloud with its regions labeled 1, 2, ...\n",
+                path.c_str());
+    return false;
   }
   if (finite == 0)
     print_warn("'%s' has no finite point: PCL's methods are reported as failed.\n",
@@ -351,7 +389,12 @@ parseOptions(int argc, char** argv, Options& opt)
     } else if (arg.size() > 1 && arg[0] == '-') {
       print_error("Unknown option '%s' (see -h).\n", arg.c_str());
       return kUsageError;
-    } else if (arg.size() < 4 || arg.compare(arg.size() - 4, 4, ".pcd") != 0) {
+    } else if (std::string ext = arg.size() < 4 ? "" : arg.substr(arg.size() - 4);
+               (std::transform(ext.begin(),
+                               ext.end(),
+                               ext.begin(),
+                               [](unsigned char c) { return std::tolower(c); }),
+                ext != ".pcd")) {
       print_error("'%s' is not a .pcd file: give PCD clouds with a label field (see "
                   "-h).\n",
                   arg.c_str());
@@ -402,8 +445,8 @@ main(int argc, char** argv)
   if (argc < 2 || find_switch(argc, argv, "-h") || find_switch(argc, argv, "--help")) {
     print_info("Compare segmenters on ground-truth clouds.\n\n"
                "Usage: %s CLOUD.pcd [CLOUD.pcd ...] [-o TABLE.md]\n"
-               "  CLOUD.pcd  x y z label (ground truth; 0 = invalid), sensor at the "
-               "origin looking along +z\n"
+               "  CLOUD.pcd  x y z label (ground truth; 0 = invalid), seen from the "
+               "file's VIEWPOINT\n"
                "  -o FILE    also write the markdown table to FILE (only when every "
                "cloud was read)\n",
                argv[0]);
@@ -412,6 +455,28 @@ main(int argc, char** argv)
   Options opt;
   if (const int code = parseOptions(argc, argv, opt))
     return code;
+  // Every input a readable file, and the table's folder writable, before the work.
+  for (const auto& input : opt.inputs) {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(input, ec) || !std::ifstream(input)) {
+      print_error("Cannot read '%s': give an existing PCD file.\n", input.c_str());
+      return kRuntimeError;
+    }
+  }
+  if (!opt.output.empty()) {
+    selseg_apps::OutputTransaction probe;
+    const std::string temporary = probe.stage(opt.output);
+    std::string error;
+    if (!probe.check(error)) {
+      print_error("%s\n", error.c_str());
+      return kRuntimeError;
+    }
+    if (!std::ofstream(temporary, std::ios::binary)) {
+      print_error("Cannot write '%s': check that the folder exists and is writable.\n",
+                  opt.output.c_str());
+      return kRuntimeError;
+    }
+  }
   std::string table = kHeader;
   std::fputs(kHeader, stdout);
   for (const auto& input : opt.inputs)

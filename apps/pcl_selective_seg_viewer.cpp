@@ -167,10 +167,17 @@ parseSize(int argc, char** argv, Options& opt)
   std::string text;
   if (parse_argument(argc, argv, "-size", text) < 0)
     return true;
-  int w = 0, h = 0;
-  char tail = 0;
-  if (std::sscanf(text.c_str(), "%dx%d%c", &w, &h, &tail) != 2 || w < 64 || h < 64 ||
-      w > 8192 || h > 8192) {
+  // Digits only (sscanf's %d would wrap a number beyond int).
+  const std::size_t x = text.find('x');
+  const auto pixels = [](const std::string& digits) {
+    if (digits.empty() || digits.size() > 5 ||
+        digits.find_first_not_of("0123456789") != std::string::npos)
+      return -1;
+    return std::stoi(digits);
+  };
+  const int w = x == std::string::npos ? -1 : pixels(text.substr(0, x));
+  const int h = x == std::string::npos ? -1 : pixels(text.substr(x + 1));
+  if (w < 64 || h < 64 || w > 8192 || h > 8192) {
     print_error("Option -size needs WIDTHxHEIGHT in pixels, each 64 to 8192, e.g. "
                 "1280x960.\n");
     return false;
@@ -265,16 +272,18 @@ parseOptions(int argc, char** argv, Options& opt)
       !selseg_apps::parseNumber(argc, argv, "-normal_step", opt.normal_step) ||
       !parseSize(argc, argv, opt) || !parseView(argc, argv, opt))
     return kUsageError;
-  if (opt.unit_scale <= 0.0) {
-    print_error("Option -unit_scale must be positive.\n");
+  if (!selseg_apps::unitScaleUsable(opt.unit_scale))
     return kUsageError;
-  }
   if (opt.normal_step < 0) {
     print_error("Option -normal_step must be 0 (automatic) or positive.\n");
     return kUsageError;
   }
-  parse_argument(argc, argv, "-screenshot", opt.screenshot);
-  parse_argument(argc, argv, "-roi_json", opt.roi_json);
+  for (const auto& [flag, value] : {std::make_pair("-screenshot", &opt.screenshot),
+                                    std::make_pair("-roi_json", &opt.roi_json)})
+    if (parse_argument(argc, argv, flag, *value) >= 0 && value->empty()) {
+      print_error("Option %s needs a file name (see -h).\n", flag);
+      return kUsageError;
+    }
   // The picture would replace the scan or the regions file it shows.
   for (const auto& [flag, read] : {std::make_pair("the input file", opt.input),
                                    std::make_pair("the -roi_json file", opt.roi_json)})
@@ -290,6 +299,20 @@ parseOptions(int argc, char** argv, Options& opt)
     print_error("Give -roi or -roi_json, not both.\n");
     return kUsageError;
   }
+  // The -roi_* settings choose the windows -roi computes; a -roi_json file's windows
+  // are drawn as they are.
+  if (!opt.roi)
+    for (int i = 1; i < argc; ++i) {
+      const std::string arg = argv[i];
+      if (arg.rfind("-roi_", 0) == 0 && arg != "-roi_json") {
+        print_error("Option %s applies with -roi (windows computed here); a -roi_json "
+                    "file's windows are drawn as they were written.\n",
+                    arg.c_str());
+        return kUsageError;
+      }
+      if (isValueFlag(arg))
+        ++i; // skip the value
+    }
   opt.ignore_viewpoint = find_switch(argc, argv, "-ignore_viewpoint");
   opt.octree_wireframe = find_switch(argc, argv, "-wireframe");
   opt.legend = !find_switch(argc, argv, "-no_legend");
@@ -550,17 +573,25 @@ buildRegions(const Scene& scene)
   const bool panoramic =
       !scene.regions.empty() &&
       scene.regions.front().projection == pcl::selective_seg::ViewProjection::Panoramic;
+  // The nearest labeled point the file's sensor sees (in front of it, for eq. 1).
   float depth = std::numeric_limits<float>::infinity();
   for (std::size_t i = 0; i < scene.cloud->size(); ++i)
     if (scene.result.labels[i] != 0) {
       const Eigen::Vector3f s = to_sensor * (*scene.cloud)[i].getVector3fMap();
-      depth = std::min(depth, panoramic ? s.norm() : s.z());
+      const float d = panoramic ? s.norm() : s.z();
+      if (d > 0.0f)
+        depth = std::min(depth, d);
     }
-  depth = std::isfinite(depth) ? 0.9f * depth : 1.0f;
   auto points = vtkSmartPointer<vtkPoints>::New();
   auto cells = vtkSmartPointer<vtkCellArray>::New();
   auto colors = newColors(0);
+  if (!scene.regions.empty() && !std::isfinite(depth))
+    print_warn("The regions file's sensor sees none of the scan's labeled points (its "
+               "pose is far from the scan's): its windows are not drawn.\n");
+  depth *= 0.9f;
   for (const auto& r : scene.regions) {
+    if (!std::isfinite(depth))
+      break;
     const double corners[4][2] = {{r.theta_min, r.phi_min},
                                   {r.theta_max, r.phi_min},
                                   {r.theta_max, r.phi_max},
@@ -574,9 +605,10 @@ buildRegions(const Scene& scene)
               ? Eigen::Vector3f(static_cast<float>(std::cos(phi) * std::sin(theta)),
                                 static_cast<float>(std::sin(phi)),
                                 static_cast<float>(std::cos(phi) * std::cos(theta)))
-              : Eigen::Vector3f(static_cast<float>(std::tan(theta)),
-                                static_cast<float>(std::tan(phi)),
-                                1.0f);
+              : Eigen::Vector3f(
+                    static_cast<float>(std::tan(std::clamp(theta, -1.56, 1.56))),
+                    static_cast<float>(std::tan(std::clamp(phi, -1.56, 1.56))),
+                    1.0f);
       const Eigen::Vector3f p = scene.regions_pose * (depth * ray);
       ids[c] = points->InsertNextPoint(p.data());
     }
@@ -889,11 +921,18 @@ main(int argc, char** argv)
   if (!opt.screenshot.empty()) {
     // A screenshot path that is not a regular file (a folder, a FIFO, a device) is
     // refused before the scan is read or a window opened.
+    // Nor is one in a folder that does not exist or cannot be written (a probe file
+    // beside it, removed at once).
     selseg_apps::OutputTransaction target;
-    target.stage(opt.screenshot);
+    const std::string probe = target.stage(opt.screenshot);
     std::string error;
     if (!target.check(error)) {
       print_error("%s\n", error.c_str());
+      return kRuntimeError;
+    }
+    if (!std::ofstream(probe, std::ios::binary)) {
+      print_error("Cannot write '%s': check that the folder exists and is writable.\n",
+                  opt.screenshot.c_str());
       return kRuntimeError;
     }
   }

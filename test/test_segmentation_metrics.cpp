@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <random>
 #include <utility>
 #include <vector>
 
@@ -426,6 +427,69 @@ TEST(BoundaryRecall, RejectsBadInput)
   EXPECT_FALSE(metrics::boundaryRecall(cloud, {1, 1, 1}, {1, 1}, 0.15, 0.1, r));
   EXPECT_FALSE(metrics::boundaryRecall(cloud, {1, 1, 1}, {1, 1, 1}, 0.0, 0.1, r));
   EXPECT_FALSE(metrics::boundaryRecall(cloud, {1, 1, 1}, {1, 1, 1}, 0.15, -0.1, r));
+}
+
+// The boundary flags come from cells grouped by label (a search of the whole ball per
+// point was quadratic in a dense cloud): the same counts as a pass over every pair,
+// with pcl::search::KdTree's rule (squared float differences summed x, y, z, strictly
+// below the squared radius), on random points with random labels, unlabeled ones
+// among the predictions, and points exactly one radius apart on a grid.
+TEST(BoundaryRecall, SameFlagsAsEveryPair)
+{
+  std::mt19937 engine(3);
+  std::uniform_real_distribution<float> at(0.0f, 0.05f);
+  std::uniform_int_distribution<std::uint32_t> label(0, 3);
+  for (const bool grid : {false, true}) {
+    pcl::PointCloud<pcl::PointXYZ> cloud;
+    Labels gt, predicted;
+    for (int i = 0; i < 1500; ++i) {
+      cloud.push_back(grid ? pcl::PointXYZ(0.01f * (i % 12),
+                                           0.01f * (i / 12 % 12),
+                                           1.0f + 0.01f * (i / 144))
+                           : pcl::PointXYZ(at(engine), at(engine), 1.0f + at(engine)));
+      gt.push_back(1 + label(engine) % 3);
+      predicted.push_back(label(engine));
+    }
+    const double radius = 0.01;
+    const auto r2 = static_cast<float>(radius * radius);
+    std::size_t gt_count = 0, predicted_count = 0;
+    for (std::size_t k = 0; k < cloud.size(); ++k) {
+      bool g = false, p = false;
+      for (std::size_t j = 0; j < cloud.size(); ++j) {
+        float sum = 0.0f;
+        const float dx = cloud[k].x - cloud[j].x, dy = cloud[k].y - cloud[j].y,
+                    dz = cloud[k].z - cloud[j].z;
+        sum += dx * dx;
+        sum += dy * dy;
+        sum += dz * dz;
+        if (!(sum < r2))
+          continue;
+        g = g || gt[j] != gt[k];
+        p = p || (predicted[k] != 0 && predicted[j] != predicted[k]);
+      }
+      gt_count += g;
+      predicted_count += p;
+    }
+    metrics::BoundaryRecall r;
+    ASSERT_TRUE(metrics::boundaryRecall(cloud, predicted, gt, radius, 0.0, r));
+    EXPECT_EQ(r.gt_boundary_points, gt_count) << (grid ? "grid" : "random");
+    EXPECT_EQ(r.predicted_boundary_points, predicted_count)
+        << (grid ? "grid" : "random");
+    EXPECT_GT(gt_count, 100u);
+  }
+  // 20,000 points inside one radius, two halves: every point is a GT boundary point,
+  // and the one predicted segment has none.
+  pcl::PointCloud<pcl::PointXYZ> dense;
+  Labels halves, one;
+  for (int i = 0; i < 20000; ++i) {
+    dense.push_back(pcl::PointXYZ(at(engine) * 0.1f, at(engine) * 0.1f, 1.0f));
+    halves.push_back(dense.back().x < 0.0025f ? 1 : 2);
+    one.push_back(1);
+  }
+  metrics::BoundaryRecall r;
+  ASSERT_TRUE(metrics::boundaryRecall(dense, one, halves, 0.02, 0.02, r));
+  EXPECT_EQ(r.gt_boundary_points, dense.size());
+  EXPECT_EQ(r.predicted_boundary_points, 0u);
 }
 
 TEST(ObjectMetrics, CombinesEveryScore)

@@ -305,8 +305,52 @@ TEST(RegionsJson, ReadsBackWhatWasWritten)
   EXPECT_FALSE(selseg_apps::readRegionsJson(path, read, error));
   EXPECT_NE(error.find("region 1"), std::string::npos) << error;
   EXPECT_TRUE(read.empty());
+  // Found by review (session 26): angles outside the projection's range were drawn
+  // folded over the view, a list of anything but windows read as no window, and a
+  // non-numeric angle was reported as a wrong order.
+  for (const auto& [bad, says] :
+       {std::pair<std::string, std::string>{
+            "{\"regions\": [{\"theta_min\": 0.2, \"theta_max\": 2.0, \"phi_min\": 0, "
+            "\"phi_max\": 0.1}]}",
+            "forward projection's range"},
+        {"{\"regions\": [{\"theta_min\": -1e300, \"theta_max\": 1e300, \"phi_min\": 0, "
+         "\"phi_max\": 0.1}]}",
+         "forward projection's range"},
+        {"{\"projection\": \"panoramic\", \"regions\": [{\"theta_min\": -7, "
+         "\"theta_max\": 7, \"phi_min\": 0, \"phi_max\": 0.1}]}",
+         "panoramic projection's range"},
+        {"{\"regions\": [1, 2, \"three\"]}", "something other than windows"},
+        {"{\"regions\": [{\"theta_min\": \"0\", \"theta_max\": 0.1, \"phi_min\": 0, "
+         "\"phi_max\": 0.1}]}",
+         "finite numbers"}}) {
+    std::ofstream(path) << bad;
+    EXPECT_FALSE(selseg_apps::readRegionsJson(path, read, error)) << bad;
+    EXPECT_NE(error.find(says), std::string::npos) << error;
+    EXPECT_TRUE(read.empty());
+  }
+  // Windows without the optional keys (box, priority, steps, reasons) read back; a
+  // missing key is looked for inside its own window only (it was searched to the end
+  // of the file once per window: 40,000 such windows took minutes).
+  {
+    std::ofstream out(path);
+    out << "{\"regions\": [";
+    for (int i = 0; i < 2000; ++i)
+      out << (i ? ", " : "") << "{\"theta_min\": " << i * 1e-4
+          << ", \"theta_max\": " << (i + 1) * 1e-4
+          << ", \"phi_min\": 0, \"phi_max\": 0.01}";
+    out << "]}";
+  }
+  ASSERT_TRUE(selseg_apps::readRegionsJson(path, read, error)) << error;
+  ASSERT_EQ(read.size(), 2000u);
+  EXPECT_EQ(read[1999].theta_max, 2000 * 1e-4);
+  EXPECT_EQ(read[1999].priority, 0.0);
   fs::remove(path);
   EXPECT_FALSE(selseg_apps::readRegionsJson(path, read, error));
+  // Only regular files: a FIFO would block the reader for ever, a device never end.
+  EXPECT_FALSE(selseg_apps::readRegionsJson("/dev/zero", read, error));
+  EXPECT_NE(error.find("not a regular file"), std::string::npos) << error;
+  EXPECT_FALSE(
+      selseg_apps::readRegionsJson(fs::temp_directory_path().string(), read, error));
 }
 
 int

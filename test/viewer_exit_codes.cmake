@@ -31,6 +31,22 @@ expect(2 "" ${INPUT} ${INPUT})
 expect(2 "" ${INPUT} -split_deg 5 -split_deg 30)
 expect(2 "" ${INPUT} -ignore_viewpoint -ignore_viewpoint)
 expect(1 "" ${MISSING} -screenshot ${MISSING}.png)
+# Found by review (session 26): an empty screenshot name ran the interactive window
+# (a hang under xvfb), a size beyond int wrapped, scales beyond float's range blamed
+# the points, and -roi_* without -roi did nothing.
+foreach(flag -screenshot -roi_json) # an empty argument: not through expect()'s list
+  execute_process(COMMAND ${VIEWER} ${INPUT} ${flag} ""
+    RESULT_VARIABLE rc OUTPUT_QUIET ERROR_VARIABLE err TIMEOUT 120)
+  if(NOT rc EQUAL 2 OR NOT err MATCHES "${flag} needs a file name")
+    set(failures "${failures}\n  '${flag} \"\"': exit '${rc}', expected 2 (${err})")
+  endif()
+endforeach()
+expect(2 "" ${INPUT} -size 4294967360x100)
+expect(2 "-unit_scale needs a number" ${INPUT} -unit_scale 1e300)
+expect(2 "-unit_scale needs a number" ${INPUT} -unit_scale 1e-300)
+expect(2 "applies with -roi" ${INPUT} -roi_max_regions 1)
+# A screenshot in a folder that does not exist: refused before the scan is segmented.
+expect(1 "check that the folder exists" ${INPUT} -screenshot ${MISSING}/x.png)
 # A screenshot naming the input would replace the scan with a PNG: refused before the
 # scan is read (so, before any rendering), the copy unchanged.
 get_filename_component(scratch ${MISSING} DIRECTORY)

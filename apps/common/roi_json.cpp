@@ -9,9 +9,11 @@
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <sstream>
+#include <string_view>
 
 #include "outputs.h"
 
@@ -38,8 +40,15 @@ findKey(const std::string& text,
 {
   const std::string quoted = "\"" + key + "\"";
   const char* space = " \t\r\n";
-  for (std::size_t at = text.find(quoted, begin); at != std::string::npos && at < end;
-       at = text.find(quoted, at + 1)) {
+  // Searched in [begin, end) only: a key missing from every region must not cost a
+  // search to the end of the file for each of them.
+  const std::string_view range =
+      std::string_view(text).substr(begin, end > begin ? end - begin : 0);
+  const auto next = [&](std::size_t from) {
+    const std::size_t found = range.find(quoted, from - begin);
+    return found == std::string_view::npos ? std::string::npos : begin + found;
+  };
+  for (std::size_t at = next(begin); at != std::string::npos; at = next(at + 1)) {
     const std::size_t before =
         at == 0 ? std::string::npos : text.find_last_not_of(space, at - 1);
     if (before == std::string::npos || (text[before] != '{' && text[before] != ','))
@@ -176,6 +185,23 @@ readRegionsJson(const std::string& path,
   regions.clear();
   sensor_pose = Eigen::Affine3f::Identity();
   has_pose = false;
+  // A regular file of a sane size: a FIFO would block and a device never end.
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (ec || !std::filesystem::is_regular_file(status)) {
+    error = "Cannot read '" + path + "': " +
+            (ec || !std::filesystem::exists(status) ? "no such file"
+                                                    : "not a regular file") +
+            " (give a regions file written with -roi_json).";
+    return false;
+  }
+  constexpr std::uintmax_t kMaxBytes = std::uintmax_t(1) << 31;
+  const std::uintmax_t bytes = std::filesystem::file_size(path, ec);
+  if (ec || bytes > kMaxBytes) {
+    error = "Cannot read '" + path + "': " +
+            (ec ? ec.message() : "larger than 2 GiB (about 6 million windows)") + ".";
+    return false;
+  }
   std::ifstream in(path);
   if (!in) {
     error = "Cannot read '" + path + "'.";
@@ -239,13 +265,37 @@ readRegionsJson(const std::string& path,
     RegionOfInterest r;
     r.projection = projection;
     double step = 0.0, current = 0.0, priority = 0.0;
+    const std::string region =
+        "'" + path + "': region " + std::to_string(regions.size() + 1);
     if (!findNumber(text, at, end, "theta_min", r.theta_min) ||
         !findNumber(text, at, end, "theta_max", r.theta_max) ||
         !findNumber(text, at, end, "phi_min", r.phi_min) ||
-        !findNumber(text, at, end, "phi_max", r.phi_max) ||
-        !(r.theta_min < r.theta_max && r.phi_min < r.phi_max)) {
-      error = "'" + path + "': region " + std::to_string(regions.size() + 1) +
-              " needs theta_min < theta_max and phi_min < phi_max.";
+        !findNumber(text, at, end, "phi_max", r.phi_max)) {
+      error = region + " needs finite numbers theta_min, theta_max, phi_min and " +
+              "phi_max [rad].";
+      regions.clear();
+      return false;
+    }
+    if (!(r.theta_min < r.theta_max && r.phi_min < r.phi_max)) {
+      error = region + " needs theta_min < theta_max and phi_min < phi_max.";
+      regions.clear();
+      return false;
+    }
+    // The projection's angles: eq. 1's theta and phi in (-pi/2, pi/2); a panorama's
+    // azimuth in [-pi, pi] and elevation in [-pi/2, pi/2].
+    const bool panoramic = projection == pcl::selective_seg::ViewProjection::Panoramic;
+    const double theta_limit = panoramic ? M_PI : M_PI / 2;
+    const auto inside = [panoramic](double angle, double limit) {
+      return panoramic ? std::abs(angle) <= limit : std::abs(angle) < limit;
+    };
+    if (!inside(r.theta_min, theta_limit) || !inside(r.theta_max, theta_limit) ||
+        !inside(r.phi_min, M_PI / 2) || !inside(r.phi_max, M_PI / 2)) {
+      error = region + " has angles outside the " +
+              (panoramic ? std::string("panoramic projection's range (theta in [-pi, "
+                                       "pi], phi in [-pi/2, pi/2])")
+                         : std::string("forward projection's range (theta and phi in "
+                                       "(-pi/2, pi/2))")) +
+              ".";
       regions.clear();
       return false;
     }
@@ -269,6 +319,16 @@ readRegionsJson(const std::string& path,
     }
     regions.push_back(r);
     at = end;
+  }
+  // A list of anything but windows is no regions file.
+  if (regions.empty()) {
+    const std::size_t open = text.find('[', findKey(text, 0, text.size(), "regions"));
+    if (open == std::string::npos ||
+        text.find_first_not_of(" \t\r\n", open + 1) != list_end) {
+      error = "'" + path + "': the \"regions\" list holds something other than " +
+              "windows (objects with theta_min, theta_max, phi_min and phi_max).";
+      return false;
+    }
   }
   return true;
 }

@@ -684,6 +684,18 @@ loadScan(const std::string& path,
 }
 
 bool
+unitScaleUsable(double unit_scale)
+{
+  if (unit_scale >= 1e-12 && unit_scale <= 1e12)
+    return true;
+  pcl::console::print_error("Option -unit_scale needs a number in [1e-12, 1e12], e.g. "
+                            "0.01 for centimetres or 0.001 for millimetres (%g would "
+                            "overflow or underflow the coordinates).\n",
+                            unit_scale);
+  return false;
+}
+
+bool
 loadLabeledScan(const std::string& path,
                 pcl::PointCloud<pcl::PointXYZ>& cloud,
                 std::vector<std::uint32_t>& labels,

@@ -31,6 +31,11 @@ bool loadScan(const std::string& path,
               pcl::PointCloud<pcl::PointXYZ>& cloud,
               std::string& error);
 
+/** \brief Whether a -unit_scale value is usable: in [1e-12, 1e12] (far beyond any unit
+ * change; outside, coordinates overflow or underflow float), else false with a
+ * message for the user. */
+bool unitScaleUsable(double unit_scale);
+
 /** \brief Read a ground-truth scan: a PCD with x, y, z and a "label" field (one
  * integer, not negative), checked as loadScan() checks a PCD.
  * \param[out] cloud the points, in file order, with the file's layout and VIEWPOINT

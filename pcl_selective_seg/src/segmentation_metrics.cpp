@@ -11,9 +11,13 @@
 #include <pcl/search/kdtree.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <numeric>
+#include <tuple>
+#include <unordered_map>
 
 namespace pcl {
 namespace selective_seg {
@@ -364,7 +368,28 @@ validPoints(const pcl::PointCloud<pcl::PointXYZ>& cloud,
   return valid;
 }
 
-/** Flags the GT and predicted boundary points among the valid points. */
+/** Whether b lies within \a radius of a as pcl::search::KdTree's radius search decides
+ * it (FLANN's L2_Simple<float>: the squared differences summed in float, x then y then
+ * z, strictly below the squared radius rounded to float). */
+bool
+withinRadius(const pcl::PointXYZ& a, const pcl::PointXYZ& b, float squared_radius)
+{
+  float sum = 0.0f;
+  const float dx = a.x - b.x, dy = a.y - b.y, dz = a.z - b.z;
+  sum += dx * dx;
+  sum += dy * dy;
+  sum += dz * dz;
+  return sum < squared_radius;
+}
+
+/** Flags the GT and predicted boundary points among the valid points: a point is a
+ * boundary when a point within the radius carries another label (for the prediction,
+ * a labeled point only). The points are bucketed in cells a little larger than the
+ * radius, each cell's points grouped by label, so that a point looks only at the
+ * other labels' points of the 27 cells around it and stops at the first within the
+ * radius: a search of the whole ball per point is quadratic in a dense cloud (50,000
+ * points within one radius took minutes). The flags are those of a radius search of
+ * pcl::search::KdTree (its distance rule, withinRadius()). */
 void
 findBoundaries(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& valid,
                const std::vector<std::uint32_t>& predicted,
@@ -373,23 +398,93 @@ findBoundaries(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& valid,
                std::vector<char>& gt_boundary,
                std::vector<char>& predicted_boundary)
 {
-  gt_boundary.assign(valid->size(), 0);
-  predicted_boundary.assign(valid->size(), 0);
-  if (valid->empty())
+  const std::size_t n = valid->size();
+  gt_boundary.assign(n, 0);
+  predicted_boundary.assign(n, 0);
+  if (n == 0)
     return;
-  pcl::search::KdTree<pcl::PointXYZ> tree(false);
-  tree.setInputCloud(valid);
-  pcl::Indices neighbours;
-  std::vector<float> sqr_distances;
-  for (std::size_t k = 0; k < valid->size(); ++k) {
-    tree.radiusSearch(static_cast<pcl::index_t>(k), radius, neighbours, sqr_distances);
-    for (const auto j : neighbours) {
-      const auto jj = static_cast<std::size_t>(j);
-      if (ground_truth[jj] != ground_truth[k])
-        gt_boundary[k] = 1;
-      if (predicted[k] != 0 && predicted[jj] != predicted[k])
-        predicted_boundary[k] = 1;
+  const auto squared_radius = static_cast<float>(radius * radius);
+  // Every point within the radius of a point lies in its cell or the 26 around it.
+  const double side = radius * (1.0 + 1e-5);
+  const Eigen::Vector3d origin = (*valid)[0].getVector3fMap().cast<double>();
+  using Key = std::array<std::int64_t, 3>;
+  struct KeyHash {
+    std::size_t operator()(const Key& k) const
+    {
+      std::uint64_t h = 1469598103934665603ull;
+      for (const auto x : k)
+        h = (h ^ static_cast<std::uint64_t>(x)) * 1099511628211ull;
+      return static_cast<std::size_t>(h ^ (h >> 29));
     }
+  };
+  std::unordered_map<Key, std::uint32_t, KeyHash> cell_of;
+  std::vector<Key> keys(n);
+  std::vector<std::uint32_t> cell(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const Eigen::Vector3d c =
+        ((*valid)[k].getVector3fMap().cast<double>() - origin) / side;
+    for (int i = 0; i < 3; ++i) // saturated far away: those cells share a key, which
+      keys[k][i] = static_cast<std::int64_t>( // only makes them hold more points
+          std::floor(std::clamp(c[i], -1e15, 1e15)));
+    cell[k] = cell_of.try_emplace(keys[k], static_cast<std::uint32_t>(cell_of.size()))
+                  .first->second;
+  }
+  const std::size_t num_cells = cell_of.size();
+  /** The points by cell, then by label; per cell, its runs of one label. */
+  struct Grouping {
+    std::vector<std::uint32_t> order;      ///< point indices
+    std::vector<std::uint32_t> run_start;  ///< per run: first entry in order
+    std::vector<std::uint32_t> cell_start; ///< per cell: first run
+  };
+  const auto group = [&](const std::vector<std::uint32_t>& labels) {
+    Grouping g;
+    g.order.resize(n);
+    std::iota(g.order.begin(), g.order.end(), 0u);
+    std::sort(g.order.begin(), g.order.end(), [&](std::uint32_t a, std::uint32_t b) {
+      return std::tie(cell[a], labels[a], a) < std::tie(cell[b], labels[b], b);
+    });
+    g.cell_start.assign(num_cells + 1, 0);
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::uint32_t p = g.order[i];
+      if (i == 0 || cell[p] != cell[g.order[i - 1]] ||
+          labels[p] != labels[g.order[i - 1]]) {
+        g.run_start.push_back(static_cast<std::uint32_t>(i));
+        ++g.cell_start[cell[p] + 1];
+      }
+    }
+    g.run_start.push_back(static_cast<std::uint32_t>(n));
+    std::partial_sum(g.cell_start.begin(), g.cell_start.end(), g.cell_start.begin());
+    return g;
+  };
+  const Grouping by_truth = group(ground_truth);
+  const Grouping by_prediction = group(predicted);
+  // Whether a point of another label than labels[k] lies within the radius of k.
+  const auto otherLabelNear =
+      [&](std::size_t k, const std::vector<std::uint32_t>& labels, const Grouping& g) {
+        const pcl::PointXYZ& q = (*valid)[k];
+        for (std::int64_t dx = -1; dx <= 1; ++dx)
+          for (std::int64_t dy = -1; dy <= 1; ++dy)
+            for (std::int64_t dz = -1; dz <= 1; ++dz) {
+              const auto it =
+                  cell_of.find({keys[k][0] + dx, keys[k][1] + dy, keys[k][2] + dz});
+              if (it == cell_of.end())
+                continue;
+              for (std::uint32_t run = g.cell_start[it->second];
+                   run < g.cell_start[it->second + 1];
+                   ++run) {
+                if (labels[g.order[g.run_start[run]]] == labels[k])
+                  continue;
+                for (std::uint32_t i = g.run_start[run]; i < g.run_start[run + 1]; ++i)
+                  if (withinRadius(q, (*valid)[g.order[i]], squared_radius))
+                    return true;
+              }
+            }
+        return false;
+      };
+  for (std::size_t k = 0; k < n; ++k) {
+    gt_boundary[k] = otherLabelNear(k, ground_truth, by_truth);
+    predicted_boundary[k] =
+        predicted[k] != 0 && otherLabelNear(k, predicted, by_prediction);
   }
 }
 

@@ -564,18 +564,71 @@ TEST_F(ToolFailure, CompareToolRejectsBrokenClouds)
     EXPECT_TRUE(outputs().empty()) << name;
   }
 
-  std::ostringstream nan;
+  // A cloud without a labeled finite point (all NaN here, or every label 0) has no
+  // ground truth to compare with: exit 1 (it gave rows of NaN scores).
+  std::ostringstream nan, zero;
   nan << pcdHeader("x y z label", "4 4 4 4", "F F F U", "1 1 1 1", 100, "ascii");
-  for (int i = 0; i < 100; ++i)
-    nan << "nan nan nan 0\n";
+  zero << pcdHeader("x y z label", "4 4 4 4", "F F F U", "1 1 1 1", 100, "ascii");
+  for (int i = 0; i < 100; ++i) {
+    nan << "nan nan nan 1\n";
+    zero << 0.01 * (i % 10) << " " << 0.01 * (i / 10) << " 1 0\n";
+  }
   writeFile(in / "nan.pcd", nan.str());
-  const Outcome o = runProgram(compare, shellQuoted(in / "nan.pcd") + table);
-  EXPECT_EQ(o.code, 0) << o.messages;
-  const std::string text = readFile(dir / "out" / "table.md");
-  for (const char* method : {"RegionGrowing", "Supervoxel+LCCP"})
-    EXPECT_NE(text.find(std::string("| nan.pcd | ") + method + " | failed"),
-              std::string::npos)
-        << text;
+  writeFile(in / "zero.pcd", zero.str());
+  for (const char* name : {"nan.pcd", "zero.pcd"}) {
+    const Outcome o = runProgram(compare, shellQuoted(in / name) + table);
+    EXPECT_EQ(o.code, 1) << o.messages;
+    EXPECT_NE(o.messages.find("has no ground-truth label"), std::string::npos)
+        << o.messages;
+    EXPECT_TRUE(outputs().empty()) << name;
+  }
+}
+
+// Found by review (session 26): PCL's integral-image normals crashed (SIGSEGV) on an
+// organized cloud under 10 pixels wide or high, and PCL's octree aborted on a cloud
+// spanning 2e7 m (one far outlier) in Supervoxel+LCCP: those methods are now reported
+// as failed, the others run.
+TEST_F(ToolFailure, CompareToolReportsWhatPclCannotRunAsFailed)
+{
+  if (compare.empty() || !fs::exists(compare))
+    GTEST_SKIP() << "pcl_selective_seg_compare missing";
+  const fs::path in = dir / "in";
+  std::ostringstream small;
+  std::string header =
+      pcdHeader("x y z label", "4 4 4 4", "F F F U", "1 1 1 1", 81, "ascii");
+  header.replace(header.find("WIDTH 81\nHEIGHT 1"), 17, "WIDTH 9\nHEIGHT 9");
+  small << header;
+  for (int i = 0; i < 81; ++i)
+    small << 0.01 * (i % 9) << " " << 0.01 * (i / 9) << " 1 " << 1 + (i % 9 > 4)
+          << "\n";
+  writeFile(in / "small.pcd", small.str());
+  std::ostringstream outlier;
+  outlier << pcdHeader("x y z label", "4 4 4 4", "F F F U", "1 1 1 1", 401, "ascii");
+  for (int i = 0; i < 400; ++i)
+    outlier << 0.01 * (i % 20) << " " << 0.01 * (i / 20) << " 1 1\n";
+  outlier << "0 0 2e7 2\n";
+  writeFile(in / "outlier.pcd", outlier.str());
+  const std::string table = dir / "out" / "table.md";
+  const Outcome o =
+      runProgram(compare,
+                 shellQuoted(in / "small.pcd") + " " + shellQuoted(in / "outlier.pcd") +
+                     " -o " + shellQuoted(table));
+  ASSERT_EQ(o.code, 0) << o.messages;
+  const std::string text = readFile(table);
+  EXPECT_NE(text.find("| small.pcd | OrganizedMultiPlane | failed"), std::string::npos)
+      << text;
+  EXPECT_NE(text.find("| outlier.pcd | Supervoxel+LCCP | failed"), std::string::npos)
+      << text;
+  EXPECT_NE(text.find("| outlier.pcd | RegionGrowing | 0."), std::string::npos) << text;
+  // A table in a folder that does not exist is refused before any cloud is read.
+  const Outcome missing = runProgram(compare,
+                                     shellQuoted(in / "small.pcd") + " -o " +
+                                         shellQuoted(dir / "no" / "t.md"));
+  EXPECT_EQ(missing.code, 1);
+  EXPECT_NE(missing.messages.find("check that the folder exists"), std::string::npos)
+      << missing.messages;
+  EXPECT_EQ(missing.messages.find("OrganizedMultiPlane"), std::string::npos)
+      << missing.messages;
 }
 
 // Its command line: unknown options, inputs that are not .pcd, -o twice or naming an
