@@ -13,7 +13,9 @@
 // extract() on the union with the first run's finest voxel
 // (docs/incremental_update.md). With bit 2 set the cloud declares a layout that is not
 // its size; the getters must still give one output point per input point. With bit 3
-// set (and not every parameter overridden) the projection is panoramic. Every
+// set (and not every parameter overridden) the projection is panoramic. With bit 4 set
+// (and not every parameter overridden), extract() restricted by indices (chosen by the
+// slot's bits 16 and up) must equal extract() on a copy of the indexed points. Every
 // successful run's regions of interest must be computed, inside the projection's
 // range of angles and with a non-negative solid angle.
 //
@@ -31,6 +33,7 @@
 
 #include <pcl/console/print.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -159,6 +162,95 @@ checkUpdate(const pcl::PointCloud<pcl::PointXYZ>& cloud,
           "update(): a cluster differs");
 }
 
+/** extract() restricted by indices against extract() on a copy of the indexed points:
+ * the same labels, segments and counts, point for point. The indices keep about three
+ * quarters of the points, chosen by \a bits, in increasing or decreasing order, with
+ * or without a repeat of some of them (a repeated index is the same point: it changes
+ * nothing); with bit 2 one index is out of range, which extract() must refuse. */
+void
+checkIndices(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& cloud,
+             const SelectiveSegmentationParameters& params,
+             const Eigen::Affine3f* pose,
+             std::uint64_t bits)
+{
+  const std::size_t n = cloud->size();
+  auto indices = pcl::make_shared<pcl::Indices>();
+  for (std::size_t i = 0; i < n; ++i)
+    if (((i * 2654435761u + (bits >> 3)) >> 7) % 4 != 0)
+      indices->push_back(static_cast<pcl::index_t>(i));
+  if (bits & 1)
+    std::reverse(indices->begin(), indices->end());
+  const pcl::Indices unique = *indices;
+  if (bits & 2)
+    for (std::size_t k = 0; k < unique.size(); k += 5)
+      indices->push_back(unique[k]);
+  if (bits & 4)
+    indices->push_back(static_cast<pcl::index_t>(n));
+
+  SelectiveSegmentation<pcl::PointXYZ> seg;
+  seg.setParameters(params);
+  if (pose)
+    seg.setSensorPose(*pose);
+  seg.setInputCloud(cloud);
+  seg.setIndices(indices);
+  std::vector<pcl::PointIndices> clusters;
+  const bool ok = seg.extract(clusters);
+  if (bits & 4) {
+    check(!ok && clusters.empty(), "extract() accepted an index outside the cloud");
+    return;
+  }
+  auto sub = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  for (const auto i : unique)
+    sub->push_back((*cloud)[static_cast<std::size_t>(i)]);
+  sub->is_dense = false;
+  SelectiveSegmentation<pcl::PointXYZ> ref;
+  ref.setParameters(params);
+  if (pose)
+    ref.setSensorPose(*pose);
+  ref.setInputCloud(sub);
+  std::vector<pcl::PointIndices> ref_clusters;
+  const bool ref_ok = ref.extract(ref_clusters);
+  check(ok == ref_ok,
+        "indices: extract() and extract() on the indexed points disagree "
+        "on success");
+  if (!ok)
+    return;
+  const auto& a = seg.getResult();
+  const auto& b = ref.getResult();
+  std::vector<char> listed(n, 0);
+  for (std::size_t k = 0; k < unique.size(); ++k) {
+    const auto i = static_cast<std::size_t>(unique[k]);
+    listed[i] = 1;
+    check(a.labels[i] == b.labels[k],
+          "indices: a label differs from the indexed points'");
+  }
+  for (std::size_t i = 0; i < n; ++i)
+    check(listed[i] || a.labels[i] == 0, "indices: a point outside them is labeled");
+  check(a.segments.size() == b.segments.size(), "indices: segment count differs");
+  for (std::size_t s = 0; s < a.segments.size(); ++s)
+    check(a.segments[s].num_points == b.segments[s].num_points &&
+              sameBits(a.segments[s].normal, b.segments[s].normal),
+          "indices: a segment differs");
+  check(a.counts.outside_indices == n - unique.size() &&
+            a.counts.labeled == b.counts.labeled &&
+            a.counts.non_finite == b.counts.non_finite &&
+            a.counts.behind_sensor == b.counts.behind_sensor &&
+            a.counts.without_normal == b.counts.without_normal &&
+            a.counts.shared_vertex == b.counts.shared_vertex,
+        "indices: the counts differ");
+  check(a.mesh.triangles.size() == b.mesh.triangles.size() &&
+            a.leaves.size() == b.leaves.size(),
+        "indices: the mesh or the leaves differ");
+  check(clusters.size() == ref_clusters.size(), "indices: cluster count differs");
+  for (std::size_t s = 0; s < clusters.size(); ++s) {
+    pcl::Indices mapped;
+    for (const auto k : ref_clusters[s].indices)
+      mapped.push_back(unique[static_cast<std::size_t>(k)]);
+    std::sort(mapped.begin(), mapped.end());
+    check(clusters[s].indices == mapped, "indices: a cluster differs");
+  }
+}
+
 } // namespace
 
 extern "C" int
@@ -244,6 +336,7 @@ LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size)
     p.delaunay_backend = pcl::selective_seg::DelaunayBackend::Sweep;
   const bool valid = p.validate();
   const bool check_update = overrides != 0xff && (slot[12] & 2) != 0;
+  const bool check_indices = overrides != 0xff && (slot[12] & 16) != 0;
 
   auto cloud = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
   const std::size_t stride = encoding == 1 ? 3 : encoding == 2 ? 6 : 12;
@@ -375,5 +468,7 @@ LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size)
             "overlapping regions of interest");
   if (check_update)
     checkUpdate(*cloud, p, pose_bytes != 0 ? &pose : nullptr);
+  if (check_indices)
+    checkIndices(cloud, p, pose_bytes != 0 ? &pose : nullptr, slot[12] >> 16);
   return 0;
 }

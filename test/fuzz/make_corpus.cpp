@@ -113,6 +113,13 @@ main(int argc, char** argv)
     std::string panoramic = sparse;
     panoramic[4 + 12 * 8] = 8;
     writeAll(seg_dir / (stem + "_sparse_i16_panoramic"), panoramic);
+    // Indices (bit 4): three quarters of the points, in increasing order; then in
+    // decreasing order with some repeated (bits 16-17 of the slot).
+    std::string indexed = sparse;
+    indexed[4 + 12 * 8] = 16;
+    writeAll(seg_dir / (stem + "_sparse_i16_indices"), indexed);
+    indexed[4 + 12 * 8 + 2] = 3;
+    writeAll(seg_dir / (stem + "_sparse_i16_indices_repeated"), indexed);
     // Reading: the same small window in every format the tool reads.
     const auto small = window(cloud, cx - 5, cy - 4, 10, 8, 3);
     const auto with_format = [&](char format, const fs::path& file) {
