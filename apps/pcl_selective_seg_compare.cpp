@@ -463,19 +463,10 @@ main(int argc, char** argv)
       return kRuntimeError;
     }
   }
-  if (!opt.output.empty()) {
-    selseg_apps::OutputTransaction probe;
-    const std::string temporary = probe.stage(opt.output);
-    std::string error;
-    if (!probe.check(error)) {
-      print_error("%s\n", error.c_str());
-      return kRuntimeError;
-    }
-    if (!std::ofstream(temporary, std::ios::binary)) {
-      print_error("Cannot write '%s': check that the folder exists and is writable.\n",
-                  opt.output.c_str());
-      return kRuntimeError;
-    }
+  std::string error;
+  if (!opt.output.empty() && !selseg_apps::outputWritable(opt.output, error)) {
+    print_error("%s\n", error.c_str());
+    return kRuntimeError;
   }
   std::string table = kHeader;
   std::fputs(kHeader, stdout);

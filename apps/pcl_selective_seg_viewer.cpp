@@ -918,23 +918,13 @@ main(int argc, char** argv)
   Options opt;
   if (const int rc = parseOptions(argc, argv, opt))
     return rc;
-  if (!opt.screenshot.empty()) {
-    // A screenshot path that is not a regular file (a folder, a FIFO, a device) is
-    // refused before the scan is read or a window opened.
-    // Nor is one in a folder that does not exist or cannot be written (a probe file
-    // beside it, removed at once).
-    selseg_apps::OutputTransaction target;
-    const std::string probe = target.stage(opt.screenshot);
-    std::string error;
-    if (!target.check(error)) {
-      print_error("%s\n", error.c_str());
-      return kRuntimeError;
-    }
-    if (!std::ofstream(probe, std::ios::binary)) {
-      print_error("Cannot write '%s': check that the folder exists and is writable.\n",
-                  opt.screenshot.c_str());
-      return kRuntimeError;
-    }
+  // A screenshot path that is not a regular file (a folder, a FIFO, a device), or in a
+  // folder that does not exist or cannot be written, is refused before the scan is
+  // read or a window opened.
+  std::string error;
+  if (!opt.screenshot.empty() && !selseg_apps::outputWritable(opt.screenshot, error)) {
+    print_error("%s\n", error.c_str());
+    return kRuntimeError;
   }
   Scene scene;
   if (!loadInput(opt, scene) || !checkDisplay() || !segment(opt, scene))

@@ -412,6 +412,21 @@ OutputTransaction::check(std::string& error) const
 }
 
 bool
+outputWritable(const std::string& path, std::string& error)
+{
+  OutputTransaction probe; // removes the probe file
+  const std::string temporary = probe.stage(path);
+  if (!probe.check(error))
+    return false;
+  if (!std::ofstream(temporary, std::ios::binary)) {
+    error =
+        "Cannot write '" + path + "': check that the folder exists and is writable.";
+    return false;
+  }
+  return true;
+}
+
+bool
 OutputTransaction::commit(std::string& error)
 {
   namespace fs = std::filesystem;

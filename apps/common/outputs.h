@@ -22,6 +22,12 @@ namespace selseg_apps {
  * an output naming the input, or two outputs naming one file, are refused with it. */
 bool samePath(const std::string& a, const std::string& b);
 
+/** \brief Whether an output file can be written, checked before the work that makes
+ * it: not a folder, device, FIFO or socket (OutputTransaction::check()), and its folder
+ * exists and takes a file (a probe file beside it, removed at once).
+ * \param[out] error the failure, naming the file and what to do */
+bool outputWritable(const std::string& path, std::string& error);
+
 /** \brief \a s as a JSON string, in quotes: quotes, backslashes and control characters
  * escaped, each ill-formed UTF-8 sequence (a file name's bytes need not be UTF-8)
  * replaced by U+FFFD, so that the file is valid JSON. */
