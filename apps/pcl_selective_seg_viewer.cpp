@@ -40,6 +40,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -244,6 +245,14 @@ parseInput(int argc, char** argv, Options& opt)
         print_error("Option %s needs a value (see -h).\n", arg.c_str());
         return false;
       }
+      // An option where the value should be (its value forgotten): "-screenshot
+      // -wireframe" wrote a file named -wireframe and switched the wireframe on.
+      if (isValueFlag(argv[i]) || isSwitch(argv[i])) {
+        print_error("Option %s needs a value, not the option '%s' (see -h).\n",
+                    arg.c_str(),
+                    argv[i]);
+        return false;
+      }
     } else if (!arg.empty() && arg[0] == '-' && !isSwitch(arg)) {
       print_error("Unknown option '%s' (see -h).\n", arg.c_str());
       return false;
@@ -294,6 +303,19 @@ parseOptions(int argc, char** argv, Options& opt)
                   read.c_str());
       return kUsageError;
     }
+  // The picture is a PNG, whatever the name says (a .jpg held PNG bytes).
+  std::string ext = opt.screenshot.size() < 4
+                        ? std::string()
+                        : opt.screenshot.substr(opt.screenshot.size() - 4);
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) {
+    return static_cast<char>(std::tolower(c));
+  });
+  if (!opt.screenshot.empty() && ext != ".png") {
+    print_error("Option -screenshot writes a PNG picture: give a name ending in .png "
+                "('%s').\n",
+                opt.screenshot.c_str());
+    return kUsageError;
+  }
   opt.roi = find_switch(argc, argv, "-roi");
   if (opt.roi && !opt.roi_json.empty()) {
     print_error("Give -roi or -roi_json, not both.\n");

@@ -45,6 +45,11 @@ expect(2 "" ${INPUT} -size 4294967360x100)
 expect(2 "-unit_scale needs a number" ${INPUT} -unit_scale 1e300)
 expect(2 "-unit_scale needs a number" ${INPUT} -unit_scale 1e-300)
 expect(2 "applies with -roi" ${INPUT} -roi_max_regions 1)
+# An option where a value should be was taken as the value (a file named -wireframe),
+# and a .jpg name got PNG bytes.
+expect(2 "needs a value, not the option '-wireframe'" ${INPUT} -screenshot -wireframe)
+expect(2 "needs a value, not the option '-roi'" ${INPUT} -roi_json -roi)
+expect(2 "give a name ending in .png" ${INPUT} -screenshot ${MISSING}.jpg)
 # A screenshot in a folder that does not exist: refused before the scan is segmented.
 expect(1 "check that the folder exists" ${INPUT} -screenshot ${MISSING}/x.png)
 # A screenshot naming the input would replace the scan with a PNG: refused before the
