@@ -17,10 +17,7 @@
 #include <tuple>
 #include <unordered_map>
 
-#ifdef _OPENMP
-#include <omp.h>
-#endif
-
+#include "int64_triple_hash.h"
 #include "parameter_checks.h"
 
 namespace pcl {
@@ -617,18 +614,10 @@ makeTileWindows(const SphericalTriangulation& tri,
     Window window;
     std::vector<double> spacing;
   };
-  struct KeyHash {
-    std::size_t operator()(const std::array<std::int64_t, 3>& k) const
-    {
-      std::uint64_t h = 1469598103934665603ull;
-      for (const auto x : k)
-        h = (h ^ static_cast<std::uint64_t>(x)) * 1099511628211ull;
-      return static_cast<std::size_t>(h ^ (h >> 29));
-    }
-  };
   std::vector<Window> windows;
   std::vector<Group> groups;
-  std::unordered_map<std::array<std::int64_t, 3>, std::size_t, KeyHash> group_of;
+  std::unordered_map<std::array<std::int64_t, 3>, std::size_t, detail::Int64TripleHash>
+      group_of;
   // Each kind's evidence vertices, numbered compactly in increasing vertex order (so a
   // set's root, its smallest member, is its smallest vertex).
   std::vector<std::int32_t> slot(nv, -1);
@@ -779,7 +768,8 @@ public:
     // a sample of at most 2^16 vertices), not their whole extent: a few far outliers
     // would otherwise widen every cell and crowd the scan's vertices into a few of
     // them. Vertices beyond go to the border cells (cell() clamps).
-    lo_ = hi_ = Eigen::Vector2d::Zero();
+    lo_ = Eigen::Vector2d::Zero();
+    Eigen::Vector2d hi = lo_;
     if (n > 0) {
       const std::size_t stride = std::max<std::size_t>(1, n >> 16);
       std::vector<double> sample;
@@ -795,14 +785,14 @@ public:
           return sample[static_cast<std::size_t>(k)];
         };
         lo_[axis] = at(0.001);
-        hi_[axis] = at(0.999);
-        if (!(hi_[axis] > lo_[axis])) { // most vertices on one line: the whole extent
+        hi[axis] = at(0.999);
+        if (!(hi[axis] > lo_[axis])) { // most vertices on one line: the whole extent
           lo_[axis] = *std::min_element(sample.begin(), sample.end());
-          hi_[axis] = *std::max_element(sample.begin(), sample.end());
+          hi[axis] = *std::max_element(sample.begin(), sample.end());
         }
       }
     }
-    Eigen::Vector2d extent = hi_ - lo_;
+    Eigen::Vector2d extent = hi - lo_;
     if (!extent.allFinite()) // not for a caller's angles (checked), but never NaN cells
       lo_ = extent = Eigen::Vector2d::Zero();
     const double cells = std::max(1.0, static_cast<double>(n) / 4.0);
@@ -865,7 +855,7 @@ private:
   }
 
   const std::vector<Eigen::Vector2d>& angles_;
-  Eigen::Vector2d lo_, hi_, scale_;
+  Eigen::Vector2d lo_, scale_;
   std::array<std::int64_t, 2> size_{{1, 1}};
   std::vector<std::size_t> start_;    ///< first entry of each cell in vertices_
   std::vector<std::size_t> vertices_; ///< by cell, in increasing number in each

@@ -19,6 +19,8 @@
 #include <tuple>
 #include <unordered_map>
 
+#include "int64_triple_hash.h"
+
 namespace pcl {
 namespace selective_seg {
 namespace metrics {
@@ -408,16 +410,7 @@ findBoundaries(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& valid,
   const double side = radius * (1.0 + 1e-5);
   const Eigen::Vector3d origin = (*valid)[0].getVector3fMap().cast<double>();
   using Key = std::array<std::int64_t, 3>;
-  struct KeyHash {
-    std::size_t operator()(const Key& k) const
-    {
-      std::uint64_t h = 1469598103934665603ull;
-      for (const auto x : k)
-        h = (h ^ static_cast<std::uint64_t>(x)) * 1099511628211ull;
-      return static_cast<std::size_t>(h ^ (h >> 29));
-    }
-  };
-  std::unordered_map<Key, std::uint32_t, KeyHash> cell_of;
+  std::unordered_map<Key, std::uint32_t, detail::Int64TripleHash> cell_of;
   std::vector<Key> keys(n);
   std::vector<std::uint32_t> cell(n);
   for (std::size_t k = 0; k < n; ++k) {
