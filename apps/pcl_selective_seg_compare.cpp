@@ -28,8 +28,6 @@
 #include <pcl/segmentation/region_growing.h>
 #include <pcl/segmentation/supervoxel_clustering.h>
 
-#include <algorithm>
-#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -62,9 +60,6 @@ struct Method {
   std::string name;
   std::function<Run(const Cloud::ConstPtr&)> run;
   bool organized_only = false;
-  /** PCL's segmenters crash on a cloud without a finite point (they index the first
-   * valid one): such a cloud is reported as failed for them, not run. */
-  bool needs_finite_points = false;
 };
 
 Labels
@@ -266,9 +261,9 @@ methods()
           {"selective (rings 3)", selective(rings3)},
           {"selective (rings 2, vertex-mean eq. 8)", selective(robust2)},
           {"selective (rings 3, vertex-mean eq. 8)", selective(robust3)},
-          {"RegionGrowing", runRegionGrowing, false, true},
-          {"Supervoxel+LCCP", runLccp, false, true},
-          {"OrganizedMultiPlane", runMultiPlane, true, true}};
+          {"RegionGrowing", runRegionGrowing},
+          {"Supervoxel+LCCP", runLccp},
+          {"OrganizedMultiPlane", runMultiPlane, true}};
 }
 
 std::string
@@ -336,28 +331,25 @@ evaluate(const std::string& path, std::string& table)
     print_error("'%s' holds no point.\n", path.c_str());
     return false;
   }
-  std::size_t finite = 0, labeled = 0;
+  std::size_t labeled = 0;
   for (std::size_t i = 0; i < cloud->size(); ++i) {
-    finite += pcl::isFinite((*cloud)[i]);
     if (!pcl::isFinite((*cloud)[i]))
       truth[i] = 0; // a point without a position is in no region
     labeled += truth[i] != 0;
   }
+  // (This also keeps PCL's segmenters, which crash on a cloud without a finite point,
+  // from running on one.)
   if (labeled == 0) {
     print_error("'%s' has no ground-truth label on a finite point (every label is 0, "
                 "the invalid label): give a cloud with its regions labeled 1, 2, ...\n",
                 path.c_str());
     return false;
   }
-  if (finite == 0)
-    print_warn("'%s' has no finite point: PCL's methods are reported as failed.\n",
-               path.c_str());
   const std::string scene = path.substr(path.find_last_of('/') + 1);
   for (const auto& method : methods()) {
     if (method.organized_only && !cloud->isOrganized())
       continue;
-    const Run run =
-        method.needs_finite_points && finite == 0 ? Run{} : method.run(cloud);
+    const Run run = method.run(cloud);
     const std::string line = row(scene, method.name, *cloud, truth, run);
     std::fputs(line.c_str(), stdout);
     std::fflush(stdout);
@@ -389,12 +381,7 @@ parseOptions(int argc, char** argv, Options& opt)
     } else if (arg.size() > 1 && arg[0] == '-') {
       print_error("Unknown option '%s' (see -h).\n", arg.c_str());
       return kUsageError;
-    } else if (std::string ext = arg.size() < 4 ? "" : arg.substr(arg.size() - 4);
-               (std::transform(ext.begin(),
-                               ext.end(),
-                               ext.begin(),
-                               [](unsigned char c) { return std::tolower(c); }),
-                ext != ".pcd")) {
+    } else if (selseg_apps::lowerExtension(arg) != ".pcd") {
       print_error("'%s' is not a .pcd file: give PCD clouds with a label field (see "
                   "-h).\n",
                   arg.c_str());

@@ -40,7 +40,6 @@
 
 #include <algorithm>
 #include <array>
-#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -304,13 +303,8 @@ parseOptions(int argc, char** argv, Options& opt)
       return kUsageError;
     }
   // The picture is a PNG, whatever the name says (a .jpg held PNG bytes).
-  std::string ext = opt.screenshot.size() < 4
-                        ? std::string()
-                        : opt.screenshot.substr(opt.screenshot.size() - 4);
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) {
-    return static_cast<char>(std::tolower(c));
-  });
-  if (!opt.screenshot.empty() && ext != ".png") {
+  if (!opt.screenshot.empty() &&
+      selseg_apps::lowerExtension(opt.screenshot) != ".png") {
     print_error("Option -screenshot writes a PNG picture: give a name ending in .png "
                 "('%s').\n",
                 opt.screenshot.c_str());
@@ -607,13 +601,13 @@ buildRegions(const Scene& scene)
   auto points = vtkSmartPointer<vtkPoints>::New();
   auto cells = vtkSmartPointer<vtkCellArray>::New();
   auto colors = newColors(0);
-  if (!scene.regions.empty() && !std::isfinite(depth))
+  static const std::vector<pcl::selective_seg::RegionOfInterest> none;
+  const auto& drawn = std::isfinite(depth) ? scene.regions : none;
+  if (drawn.size() != scene.regions.size())
     print_warn("The regions file's sensor sees none of the scan's labeled points (its "
                "pose is far from the scan's): its windows are not drawn.\n");
   depth *= 0.9f;
-  for (const auto& r : scene.regions) {
-    if (!std::isfinite(depth))
-      break;
+  for (const auto& r : drawn) {
     const double corners[4][2] = {{r.theta_min, r.phi_min},
                                   {r.theta_max, r.phi_min},
                                   {r.theta_max, r.phi_max},

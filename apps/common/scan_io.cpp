@@ -22,7 +22,6 @@
 #include <vector>
 
 namespace selseg_apps {
-namespace {
 
 std::string
 lowerExtension(const std::string& path)
@@ -36,6 +35,8 @@ lowerExtension(const std::string& path)
   });
   return ext;
 }
+
+namespace {
 
 bool
 hasXYZ(const pcl::PCLPointCloud2& blob)

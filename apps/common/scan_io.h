@@ -15,6 +15,10 @@
 
 namespace selseg_apps {
 
+/** \brief The file name's extension from its last dot, lower case (".pcd"), or "" when
+ * it has none. */
+std::string lowerExtension(const std::string& path);
+
 /** \brief Read a scan: PCD or PLY (any point type with x, y and z fields) or plain text
  * with "x y z" per line (further columns ignored, '#' comments and blank lines
  * skipped).
