@@ -537,8 +537,9 @@ TEST_F(ToolFailure, HeadersPclReadsDifferentlyAreRefused)
 // pcl_selective_seg_compare reads its clouds with the tool's checked reader: a file
 // that is empty, noise or declares four billion points is a message and exit 1 (PCL's
 // reader crashed on the first two, and the third aborted on std::bad_alloc), and -o
-// writes nothing. A cloud without a finite point runs (PCL's segmenters crashed on
-// it): they are reported as failed.
+// writes nothing. A cloud without a labeled finite point is refused too (PCL's
+// segmenters crashed on a cloud without a finite point; they were then reported as
+// failed, with rows of NaN scores).
 TEST_F(ToolFailure, CompareToolRejectsBrokenClouds)
 {
   if (compare.empty() || !fs::exists(compare))
