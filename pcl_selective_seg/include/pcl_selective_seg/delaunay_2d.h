@@ -34,8 +34,8 @@ constexpr std::int32_t kMaxDelaunayCoordinate = 1 << 26;
 namespace detail {
 /** \brief The fewest items (triangles, vertices, sampled edges, list items) a loop of
  * the pipeline splits among threads; below it one thread is as fast. Measured on door
- * scans of 5k-46k points (docs/performance_notes.md, round 5 and session 17). No result
- * depends on it. */
+ * scans of 5k-46k points (docs/performance_history.md, "Round 5" and "passes from 8,192
+ * points (session 17)"). No result depends on it. */
 constexpr std::size_t kMinParallelItems = 8192;
 } // namespace detail
 
@@ -44,8 +44,8 @@ using Triangle = std::array<pcl::index_t, 3>;
 
 /** \brief Delaunay backends. */
 enum class DelaunayBackend : std::uint8_t {
-  /** Dual of Boost.Polygon's exact Voronoi diagram (default; BSD-compatible licence).
-   */
+  /** Dual of Boost.Polygon's exact Voronoi diagram (BSD-compatible licence): the same
+   * triangles as Sweep, several times slower. Sweep is the default. */
   BoostVoronoi = 0,
   /** VTK's vtkDelaunay2D (the design's original choice). Available only when the
    * library was built with VTK (see isDelaunayBackendAvailable()). Floating point: it

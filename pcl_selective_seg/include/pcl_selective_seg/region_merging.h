@@ -86,15 +86,15 @@ struct MergeInput {
  * of a seed of S_k that has a vertex outside S_k (an edge triangle) and whose normal is
  * within max_edge_triangle_angle of N_Sk (valid edge, eq. 8), each unassigned seed at
  * its vertices joins S_k when its normal is within max_merge_angle of N_Sk (eq. 9-10).
- * N_Sk is the normalized sum of N_v / A_v over its seeds (eq. 7), updated at every
- * join. Each seed joins once and each triangle is examined at most once per leaf of
+ * N_Sk is the normalized sum of N_v / A_v (N_v A_v with segment_normal_weight = Area)
+ * over its seeds (eq. 7), updated at every join. Each seed joins once and each triangle is examined at most once per leaf of
  * its vertices: linear in the mesh size.
  *
  * With several threads and at least 1,024 leaves, the threads grow seeds ahead of
  * their turn, each over its own part of the leaves, and a segment so grown is kept
  * only when the state it met is the one the sequential growth meets (otherwise it
  * grows again in turn): the result is the one-thread result, bit for bit
- * (docs/performance.md, "Round 6").
+ * (docs/performance_history.md, "Round 6").
  *
  * \param[in] input the seeds and the mesh. A missing array, or arrays whose sizes
  *            disagree, give a PCL_ERROR and empty outputs. Not checked (a pass over

@@ -46,7 +46,9 @@ struct StageTimings {
 struct PointCounts {
   std::size_t outside_indices = 0; ///< not listed in the indices (label 0)
   std::size_t non_finite = 0;      ///< NaN or Inf coordinate (label 0)
-  std::size_t behind_sensor = 0;   ///< z <= 0 in the sensor frame: no image (label 0)
+  /** No image (label 0): z <= 0 in the sensor frame (forward projection), or at the
+   * sensor's own position (panoramic). */
+  std::size_t behind_sensor = 0;
   /** No triangle, or only degenerate ones, around it (label 0). Without a triangle:
    * with the panoramic projection, an outlying point at the top or bottom of the view
    * (delaunay2dPeriodic()). */

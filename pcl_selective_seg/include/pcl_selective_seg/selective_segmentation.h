@@ -242,7 +242,7 @@ public:
    * per triangle are in getResult().mesh); empty before a successful extract(). */
   void getPolygonMesh(pcl::PolygonMesh& mesh) const;
 
-  /** \brief The triangulation of the last extract(): the vertex of every input point,
+  /** \brief The triangulation of the last extract() or update(): the vertex of every input point,
    * the vertices' representative points, angles and sensor-frame positions. Its
    * neighbours are left empty: the triangle adjacency is getResult().mesh.neighbours
    * (same triangle order), stored once. */
@@ -251,7 +251,7 @@ public:
     return delaunay_.getTriangulation();
   }
 
-  /** \brief The multi-resolution octree of the last extract(), over the mesh vertices
+  /** \brief The multi-resolution octree of the last extract() or update(), over the mesh vertices
    * in the sensor frame (its point i is vertex i of getTriangulation()). */
   typename Octree::ConstPtr getOctree() const { return octree_; }
 
