@@ -380,14 +380,8 @@ private:
 // The library's instantiations (point_types.h) are used as they are: a program's own
 // copies of them (implicit instantiations, weak symbols) would take their place at
 // load time, compiled with that program's flags (without OpenMP: the stages on one
-// thread) and recompiled in every file that uses them.
-#ifndef PCL_NO_PRECOMPILE
+// thread) and recompiled in every file that uses them. Declared whether or not
+// PCL_NO_PRECOMPILE is defined: the library always holds them, and a program that
+// defines it for its own point type must not replace them.
 #include <pcl_selective_seg/point_types.h>
-
-#include <pcl/impl/instantiate.hpp>
-
-#define PCL_INSTANTIATE_OctreePointCloudNormalVarianceDeclaration(T)                   \
-  extern template class PCL_EXPORTS pcl::selective_seg::OctreePointCloudNormalVariance<T>;
-PCL_INSTANTIATE(OctreePointCloudNormalVarianceDeclaration, PCL_SELSEG_POINT_TYPES)
-#undef PCL_INSTANTIATE_OctreePointCloudNormalVarianceDeclaration
-#endif
+PCL_SELSEG_EXTERN_TEMPLATES(pcl::selective_seg::OctreePointCloudNormalVariance)

@@ -187,7 +187,7 @@ public:
   Eigen::Affine3f getSensorPose() const
   {
     return mesh_pose_.isZero() ? delaunay_.getSensorPose()
-                               : Eigen::Affine3f(mesh_pose_);
+                               : Eigen::Affine3f(Eigen::Matrix4f(mesh_pose_));
   }
 
   /** \brief Run the whole pipeline.
@@ -368,7 +368,10 @@ private:
   SegmentationResult result_;
   /** Parameters and sensor pose the current mesh and normals were computed with. */
   SelectiveSegmentationParameters mesh_params_;
-  Eigen::Matrix4f mesh_pose_ = Eigen::Matrix4f::Zero();
+  /** Unaligned: the layout must not depend on the user's -march (see
+   * SphericalDelaunay::sensor_pose_). */
+  Eigen::Matrix<float, 4, 4, Eigen::DontAlign> mesh_pose_ =
+      Eigen::Matrix<float, 4, 4, Eigen::DontAlign>::Zero();
   /** The cloud and indices the current mesh was made from (noteMeshInput()): update()
    * folds new points into the result in place only while they are still the input. */
   typename PointCloud::ConstPtr mesh_input_;
@@ -408,3 +411,8 @@ private:
 #ifdef PCL_NO_PRECOMPILE
 #include <pcl_selective_seg/impl/selective_segmentation.hpp>
 #endif
+
+// The library's own instantiations are used even when the bodies are visible
+// (PCL_NO_PRECOMPILE): see octree_pointcloud_normal_variance.h.
+#include <pcl_selective_seg/point_types.h>
+PCL_SELSEG_EXTERN_TEMPLATES(pcl::selective_seg::SelectiveSegmentation)

@@ -249,7 +249,12 @@ private:
   DelaunayBackend backend_ = DelaunayBackend::Sweep;
   double angle_quantization_ = 1e-7;
   ViewProjection projection_ = ViewProjection::Forward;
-  Eigen::Affine3f sensor_pose_ = Eigen::Affine3f::Identity();
+  /** Unaligned storage (as every member of the installed classes must be): Eigen aligns
+   * a 64-byte matrix to 16, 32 or 64 bytes depending on the compiler's -m flags (SSE,
+   * AVX, AVX-512), so an aligned member would give this class another layout in a
+   * program built with -march=native than in the library. */
+  Eigen::Transform<float, 3, Eigen::Affine, Eigen::DontAlign> sensor_pose_ =
+      Eigen::Transform<float, 3, Eigen::Affine, Eigen::DontAlign>::Identity();
   bool has_sensor_pose_ = false;
   SphericalTriangulation triangulation_;
   unsigned int num_threads_ = defaultThreads();
@@ -262,3 +267,8 @@ private:
 #ifdef PCL_NO_PRECOMPILE
 #include <pcl_selective_seg/impl/spherical_delaunay.hpp>
 #endif
+
+// The library's own instantiations are used even when the bodies are visible
+// (PCL_NO_PRECOMPILE): see octree_pointcloud_normal_variance.h.
+#include <pcl_selective_seg/point_types.h>
+PCL_SELSEG_EXTERN_TEMPLATES(pcl::selective_seg::SphericalDelaunay)

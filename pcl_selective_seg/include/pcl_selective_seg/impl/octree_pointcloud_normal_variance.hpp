@@ -230,7 +230,8 @@ OctreePointCloudNormalVariance<PointT>::insertPoints(bool with_angles)
   unsigned depth = 0;
   bool keys_fit = false;
   for (int attempt = 0; attempt < 2 && !keys_fit; ++attempt) {
-    const double widen = attempt * std::numeric_limits<float>::epsilon();
+    const double widen =
+        static_cast<double>(attempt) * std::numeric_limits<float>::epsilon();
     this->defineBoundingBox(
         lo.x(), lo.y(), lo.z(), hi.x() + widen, hi.y() + widen, hi.z() + widen);
     depth = static_cast<unsigned>(this->octree_depth_);

@@ -727,7 +727,7 @@ SelectiveSegmentation<PointT>::cloudShapedLikeTheRun(
   if (runLayoutIsItsSize())
     *out = CloudT(run.width, run.height, fill);
   else
-    out->resize(run.size(), fill);
+    out->resize(static_cast<pcl::index_t>(run.size()), fill);
   out->header = run.header;
   return out;
 }

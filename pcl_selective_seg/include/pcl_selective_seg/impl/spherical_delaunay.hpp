@@ -87,7 +87,7 @@ Eigen::Affine3f
 SphericalDelaunay<PointT>::getSensorPose() const
 {
   if (has_sensor_pose_ || !this->input_)
-    return sensor_pose_;
+    return Eigen::Affine3f(sensor_pose_.matrix());
   Eigen::Affine3f pose = Eigen::Affine3f::Identity();
   pose.translation() = this->input_->sensor_origin_.template head<3>();
   pose.linear() = this->input_->sensor_orientation_.normalized().toRotationMatrix();

@@ -7,6 +7,8 @@
 #pragma once
 
 #include <pcl_selective_seg/spherical_delaunay.h>
+// detail::kExcludedKey, detail::keyAngles (non-dependent names: needed at definition)
+#include <pcl_selective_seg/impl/spherical_delaunay.hpp>
 
 #include <pcl/console/print.h>
 
