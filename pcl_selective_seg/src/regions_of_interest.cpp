@@ -87,15 +87,16 @@ finiteAtLeast(double value, double lo)
   return std::isfinite(value) && value >= lo;
 }
 
-/** Union-find over vertices, with path halving; the root is the smallest member. */
+/** Union-find over at most 2^32 - 1 items (vertices), with path halving; the root is
+ * the smallest member. */
 class DisjointSets {
 public:
   explicit DisjointSets(std::size_t n)
       : parent_(n)
   {
-    std::iota(parent_.begin(), parent_.end(), 0);
+    std::iota(parent_.begin(), parent_.end(), 0u);
   }
-  std::size_t find(std::size_t x)
+  std::uint32_t find(std::uint32_t x)
   {
     while (parent_[x] != x) {
       parent_[x] = parent_[parent_[x]];
@@ -103,7 +104,7 @@ public:
     }
     return x;
   }
-  void unite(std::size_t a, std::size_t b)
+  void unite(std::uint32_t a, std::uint32_t b)
   {
     a = find(a);
     b = find(b);
@@ -112,7 +113,7 @@ public:
   }
 
 private:
-  std::vector<std::size_t> parent_;
+  std::vector<std::uint32_t> parent_;
 };
 
 /** A window under construction. */
@@ -616,8 +617,15 @@ makeTileWindows(const SphericalTriangulation& tri,
   };
   std::vector<Window> windows;
   std::vector<Group> groups;
+  const detail::Int64TripleHash hash;
   std::unordered_map<std::array<std::int64_t, 3>, std::size_t, detail::Int64TripleHash>
       group_of;
+  constexpr std::uint32_t kNoGroup = std::numeric_limits<std::uint32_t>::max();
+  struct CachedGroup {
+    std::array<std::int64_t, 3> key{};
+    std::uint32_t group = kNoGroup;
+  };
+  std::vector<CachedGroup> cache(std::size_t{1} << 12); // a power of two
   // Each kind's evidence vertices, numbered compactly in increasing vertex order (so a
   // set's root, its smallest member, is its smallest vertex).
   std::vector<std::int32_t> slot(nv, -1);
@@ -638,44 +646,67 @@ makeTileWindows(const SphericalTriangulation& tri,
         const auto a = slot[static_cast<std::size_t>(t[k])];
         const auto b = slot[static_cast<std::size_t>(t[(k + 1) % 3])];
         if (a >= 0 && b >= 0)
-          sets.unite(static_cast<std::size_t>(a), static_cast<std::size_t>(b));
+          sets.unite(static_cast<std::uint32_t>(a), static_cast<std::uint32_t>(b));
       }
     // Tiles start at the component's smallest angles: a component that fits in one
-    // tile gives one window.
+    // tile gives one window. Its smallest theta is its root's, the smallest vertex
+    // (vertices are numbered in theta order: checked by the caller).
     const std::size_t m = members.size();
-    std::vector<std::size_t> size(m, 0);
-    std::vector<Eigen::Vector2d> start(
-        m, Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity()));
+    std::vector<std::uint32_t> root(m), size(m, 0);
+    std::vector<double> start_phi(m, std::numeric_limits<double>::infinity());
     for (std::size_t i = 0; i < m; ++i) {
-      const std::size_t root = sets.find(i);
-      ++size[root];
-      start[root] = start[root].cwiseMin(angles[static_cast<std::size_t>(members[i])]);
+      root[i] = sets.find(static_cast<std::uint32_t>(i));
+      ++size[root[i]];
+      start_phi[root[i]] = std::min(start_phi[root[i]],
+                                    angles[static_cast<std::size_t>(members[i])].y());
     }
+    // Each kept member's group, then the groups filled at their final sizes (their
+    // lists grown one vertex at a time spent most of this in reallocations). Groups
+    // are few (thousands), but consecutive members mostly lie in different ones (they
+    // differ in phi): a direct-mapped cache of the keys seen is tried before the map.
     groups.clear();
     group_of.clear();
+    std::vector<std::uint32_t> group(m, kNoGroup);
+    std::vector<std::size_t> count;
+    std::fill(cache.begin(), cache.end(), CachedGroup{});
     for (std::size_t i = 0; i < m; ++i) {
-      const std::size_t root = sets.find(i);
       const auto v = static_cast<std::size_t>(members[i]);
       slot[v] = -1; // ready for the next kind
-      if (size[root] < p.min_component_vertices)
+      if (size[root[i]] < p.min_component_vertices)
         continue;
       kept[v] |= kind;
       // At most pi / 1e-9 (validate()): the tile numbers fit an integer.
-      const Eigen::Vector2d tile = (angles[v] - start[root]) / p.max_window_size;
+      const Eigen::Vector2d start(
+          angles[static_cast<std::size_t>(members[root[i]])].x(), start_phi[root[i]]);
+      const Eigen::Vector2d tile = (angles[v] - start) / p.max_window_size;
       const std::array<std::int64_t, 3> key = {
-          static_cast<std::int64_t>(members[root]),
+          static_cast<std::int64_t>(members[root[i]]),
           static_cast<std::int64_t>(std::floor(tile.x())),
           static_cast<std::int64_t>(std::floor(tile.y()))};
-      const auto [it, fresh] = group_of.emplace(key, groups.size());
-      if (fresh) {
-        groups.push_back({key, Window::none(), {}});
-        groups.back().window.reasons = kind;
+      CachedGroup& cached = cache[hash(key) & (cache.size() - 1)];
+      if (cached.group == kNoGroup || cached.key != key) {
+        const auto [it, fresh] = group_of.try_emplace(key, groups.size());
+        if (fresh) {
+          groups.push_back({key, Window::none(), {}});
+          groups.back().window.reasons = kind;
+          count.push_back(0);
+        }
+        cached = {key, static_cast<std::uint32_t>(it->second)};
       }
-      Group& g = groups[it->second];
-      g.window.include(angles[v]);
-      g.window.evidence.push_back(static_cast<pcl::index_t>(v));
-      g.spacing.push_back(spacing[v]);
+      group[i] = cached.group;
+      ++count[cached.group];
+      groups[cached.group].window.include(angles[v]);
     }
+    for (std::size_t g = 0; g < groups.size(); ++g) {
+      groups[g].window.evidence.reserve(count[g]);
+      groups[g].spacing.reserve(count[g]);
+    }
+    for (std::size_t i = 0; i < m; ++i)
+      if (group[i] != kNoGroup) {
+        Group& g = groups[group[i]];
+        g.window.evidence.push_back(members[i]);
+        g.spacing.push_back(spacing[static_cast<std::size_t>(members[i])]);
+      }
     std::sort(groups.begin(), groups.end(), [](const Group& a, const Group& b) {
       return a.key < b.key;
     });
@@ -757,10 +788,21 @@ mergeWindows(std::vector<Window>& windows, const RegionOfInterestParameters& p)
 
 /** The vertices bucketed by their angles on a uniform grid of about four vertices a
  * cell, so that the vertices inside a window are found among the cells it overlaps
- * rather than in its whole band of theta. */
+ * rather than in its whole band of theta. Each cell also holds its vertex count and
+ * the bounds of its vertices' positions, for the cells wholly inside a window. */
 class VertexGrid {
 public:
-  explicit VertexGrid(const std::vector<Eigen::Vector2d>& angles)
+  /** Bounds of the finite positions of a cell's vertices (empty: max > min). */
+  struct Summary {
+    std::size_t count = 0;
+    Eigen::Vector3f min = Eigen::Vector3f::Constant(std::numeric_limits<float>::max());
+    Eigen::Vector3f max =
+        Eigen::Vector3f::Constant(std::numeric_limits<float>::lowest());
+  };
+
+  /** \a position(v): vertex v's position, as windows' boxes are made of. */
+  template <typename Position>
+  VertexGrid(const std::vector<Eigen::Vector2d>& angles, Position position, int threads)
       : angles_(angles)
   {
     const std::size_t n = angles.size();
@@ -816,18 +858,45 @@ public:
     std::vector<std::size_t> next(start_.begin(), start_.end() - 1);
     for (std::size_t v = 0; v < n; ++v)
       vertices_[next[index(angles[v].x(), angles[v].y())]++] = v;
+    summaries_.resize(start_.size() - 1);
+    const auto count = static_cast<std::ptrdiff_t>(summaries_.size());
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(threads) schedule(static) if (n >= kParallelFrom)
+#endif
+    for (std::ptrdiff_t k = 0; k < count; ++k) {
+      Summary& sum = summaries_[static_cast<std::size_t>(k)];
+      for (std::size_t i = start_[k]; i < start_[k + 1]; ++i) {
+        const Eigen::Vector3f x = position(vertices_[i]);
+        ++sum.count;
+        if (!x.allFinite())
+          continue;
+        sum.min = sum.min.cwiseMin(x);
+        sum.max = sum.max.cwiseMax(x);
+      }
+    }
   }
 
-  /** Calls f(v) for every vertex v whose angles lie in the window, borders included. */
-  template <typename F>
-  void forEachIn(
-      double theta_min, double theta_max, double phi_min, double phi_max, F f) const
+  /** The vertices whose angles lie in the window, borders included: g(summary) for
+   * every cell all of whose vertices do, f(v) for each of the others. (cell() is
+   * monotone: a vertex of a cell strictly between the window's first and last cells
+   * along an axis lies between the window's borders along it.) */
+  template <typename F, typename G>
+  void forEachIn(double theta_min,
+                 double theta_max,
+                 double phi_min,
+                 double phi_max,
+                 F f,
+                 G g) const
   {
     const std::int64_t c0 = cell(theta_min, 0), c1 = cell(theta_max, 0);
     const std::int64_t r0 = cell(phi_min, 1), r1 = cell(phi_max, 1);
     for (std::int64_t c = c0; c <= c1; ++c)
       for (std::int64_t r = r0; r <= r1; ++r) {
         const auto k = static_cast<std::size_t>(c * size_[1] + r);
+        if (c > c0 && c < c1 && r > r0 && r < r1) {
+          g(summaries_[k]);
+          continue;
+        }
         for (std::size_t i = start_[k]; i < start_[k + 1]; ++i) {
           const std::size_t v = vertices_[i];
           const Eigen::Vector2d& a = angles_[v];
@@ -859,6 +928,7 @@ private:
   std::array<std::int64_t, 2> size_{{1, 1}};
   std::vector<std::size_t> start_;    ///< first entry of each cell in vertices_
   std::vector<std::size_t> vertices_; ///< by cell, in increasing number in each
+  std::vector<Summary> summaries_;    ///< by cell
 };
 
 /** Windows registered in the cells of a uniform grid of angles that they overlap, for
@@ -923,12 +993,15 @@ cutAround(const Window& c,
           const std::vector<double>& spacing,
           const RegionOfInterestParameters& p)
 {
-  std::vector<pcl::index_t> all = c.evidence;
-  all.insert(all.end(), c.reach.begin(), c.reach.end());
-  std::vector<double> local;
-  for (const auto v : all)
-    local.push_back(spacing[v]);
-  const double margin = p.margin + p.margin_spacings * median(local);
+  const std::size_t ne = c.evidence.size(), n = ne + c.reach.size();
+  // c's evidence, then the evidence whose margin reaches into it.
+  const auto vertex = [&](std::size_t i) {
+    return i < ne ? c.evidence[i] : c.reach[i - ne];
+  };
+  std::vector<double> local(n);
+  for (std::size_t i = 0; i < n; ++i)
+    local[i] = spacing[static_cast<std::size_t>(vertex(i))];
+  const double margin = p.margin + p.margin_spacings * median(std::move(local));
   std::array<Window, 4> limits;
   limits.fill(c);
   limits[0].theta_max = s.theta_min; // left
@@ -952,36 +1025,47 @@ cutAround(const Window& c,
     return -1;
   };
   // Otherwise, the margin box about a vertex must reach into a part by more than a
-  // touch (rounding of the margins along a shared border).
+  // touch (rounding of the margins along a shared border). One pass over the vertices
+  // fills the four parts, each in the vertices' order.
   const double reach = margin - kTouch;
-  std::vector<Window> out;
+  std::array<Window, 4> parts;
+  std::array<std::uint8_t, 4> reach_reasons{};
+  std::array<bool, 4> open{};
   for (int k = 0; k < 4; ++k) {
-    const Window& lim = limits[k];
-    if (!(lim.width() > 0.0 && lim.height() > 0.0))
-      continue;
-    Window part = Window::none();
-    std::uint8_t reach_reasons = 0;
-    for (std::size_t i = 0; i < all.size(); ++i) {
-      const auto v = all[i];
-      const Eigen::Vector2d& a = angles[v];
-      const bool own = i < c.evidence.size() && owner(a) == k;
-      if (!own && !(a.x() + reach > lim.theta_min && a.x() - reach < lim.theta_max &&
-                    a.y() + reach > lim.phi_min && a.y() - reach < lim.phi_max))
+    parts[k] = Window::none();
+    open[k] = limits[k].width() > 0.0 && limits[k].height() > 0.0;
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto v = vertex(i);
+    const Eigen::Vector2d& a = angles[static_cast<std::size_t>(v)];
+    const int own = i < ne ? owner(a) : -1;
+    for (int k = 0; k < 4; ++k) {
+      if (!open[k])
         continue;
+      const Window& lim = limits[k];
+      if (own != k &&
+          !(a.x() + reach > lim.theta_min && a.x() - reach < lim.theta_max &&
+            a.y() + reach > lim.phi_min && a.y() - reach < lim.phi_max))
+        continue;
+      Window& part = parts[k];
       part.include(a);
-      if (own) {
+      if (own == k) {
         part.reasons |= kept[v] & c.reasons;
         part.evidence.push_back(v);
       } else {
-        reach_reasons |= kept[v] & c.reasons;
+        reach_reasons[k] |= kept[v] & c.reasons;
         part.reach.push_back(v);
       }
     }
-    if (part.evidence.empty() && part.reach.empty())
+  }
+  std::vector<Window> out;
+  for (int k = 0; k < 4; ++k) {
+    Window& part = parts[k];
+    if (!open[k] || (part.evidence.empty() && part.reach.empty()))
       continue;
-    growWithin(part, margin, p, lim);
+    growWithin(part, margin, p, limits[k]);
     if (part.reasons == 0)
-      part.reasons = reach_reasons != 0 ? reach_reasons : c.reasons;
+      part.reasons = reach_reasons[k] != 0 ? reach_reasons[k] : c.reasons;
     if (part.width() > kTouch && part.height() > kTouch)
       out.push_back(std::move(part));
   }
@@ -1275,16 +1359,22 @@ computeRegionsOfInterest(const SegmentationResult& result,
   mergeWindows(windows, p);
   st.candidates = windows.size();
 
-  const VertexGrid grid(angles);
+  // A vertex's position in the cloud frame, for the windows' boxes.
+  const auto cloudPosition = [&](std::size_t v) -> Eigen::Vector3f {
+    return (to_cloud * tri.vertex_positions[v].cast<double>()).cast<float>();
+  };
+  const VertexGrid grid(angles, cloudPosition, threads);
   // A window as a region: steps, priority, estimates and its box; or why it is
   // dropped: already sampled about as finely as it would be (min_refinement), or a
   // part holding no evidence of its own narrower than a step.
   enum class Fate { Kept, AlreadyFine, Thin };
   const auto evaluate = [&](Window& w, RegionOfInterest& r) {
     auto& ev = w.evidence;
-    std::sort(ev.begin(), ev.end());
+    if (!std::is_sorted(ev.begin(), ev.end())) // the parts of a cut keep their order
+      std::sort(ev.begin(), ev.end());
     ev.erase(std::unique(ev.begin(), ev.end()), ev.end());
     std::vector<double> local;
+    local.reserve(ev.size());
     double weighted = 0.0, covered = 0.0;
     for (const auto v : ev) {
       local.push_back(spacing[v]);
@@ -1303,7 +1393,7 @@ computeRegionsOfInterest(const SegmentationResult& result,
     if (ev.empty())
       for (const auto v : w.reach)
         local.push_back(spacing[v]);
-    r.current_step = median(local);
+    r.current_step = median(std::move(local));
     r.suggested_step =
         p.target_step > 0.0 ? p.target_step : r.current_step / p.refinement_factor;
     if (!(r.suggested_step > 0.0) ||
@@ -1326,15 +1416,24 @@ computeRegionsOfInterest(const SegmentationResult& result,
     // (angles[v]), so that evidence on a border is inside.
     r.box_min = Eigen::Vector3f::Constant(std::numeric_limits<float>::max());
     r.box_max = Eigen::Vector3f::Constant(std::numeric_limits<float>::lowest());
-    grid.forEachIn(r.theta_min, r.theta_max, r.phi_min, r.phi_max, [&](std::size_t v) {
-      ++r.num_points;
-      const Eigen::Vector3f x =
-          (to_cloud * tri.vertex_positions[v].cast<double>()).cast<float>();
-      if (!x.allFinite())
-        return;
-      r.box_min = r.box_min.cwiseMin(x);
-      r.box_max = r.box_max.cwiseMax(x);
-    });
+    grid.forEachIn(
+        r.theta_min,
+        r.theta_max,
+        r.phi_min,
+        r.phi_max,
+        [&](std::size_t v) {
+          ++r.num_points;
+          const Eigen::Vector3f x = cloudPosition(v);
+          if (!x.allFinite())
+            return;
+          r.box_min = r.box_min.cwiseMin(x);
+          r.box_max = r.box_max.cwiseMax(x);
+        },
+        [&](const VertexGrid::Summary& cell) {
+          r.num_points += cell.count;
+          r.box_min = r.box_min.cwiseMin(cell.min);
+          r.box_max = r.box_max.cwiseMax(cell.max);
+        });
     // The weighted share of the window's area its evidence stands for (each vertex
     // spacing^2), times the share of new samples a scan at the suggested step brings.
     r.priority =
