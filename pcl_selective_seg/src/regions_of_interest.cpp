@@ -792,9 +792,8 @@ mergeWindows(std::vector<Window>& windows, const RegionOfInterestParameters& p)
  * the bounds of its vertices' positions, for the cells wholly inside a window. */
 class VertexGrid {
 public:
-  /** Bounds of the finite positions of a cell's vertices (empty: max > min). */
+  /** Bounds of the finite positions of a cell's vertices (none: min > max). */
   struct Summary {
-    std::size_t count = 0;
     Eigen::Vector3f min = Eigen::Vector3f::Constant(std::numeric_limits<float>::max());
     Eigen::Vector3f max =
         Eigen::Vector3f::Constant(std::numeric_limits<float>::lowest());
@@ -867,7 +866,6 @@ public:
       Summary& sum = summaries_[static_cast<std::size_t>(k)];
       for (std::size_t i = start_[k]; i < start_[k + 1]; ++i) {
         const Eigen::Vector3f x = position(vertices_[i]);
-        ++sum.count;
         if (!x.allFinite())
           continue;
         sum.min = sum.min.cwiseMin(x);
@@ -876,8 +874,8 @@ public:
     }
   }
 
-  /** The vertices whose angles lie in the window, borders included: g(summary) for
-   * every cell all of whose vertices do, f(v) for each of the others. (cell() is
+  /** The vertices whose angles lie in the window, borders included: g(count, summary)
+   * for every cell all of whose vertices do, f(v) for each of the others. (cell() is
    * monotone: a vertex of a cell strictly between the window's first and last cells
    * along an axis lies between the window's borders along it.) */
   template <typename F, typename G>
@@ -894,7 +892,7 @@ public:
       for (std::int64_t r = r0; r <= r1; ++r) {
         const auto k = static_cast<std::size_t>(c * size_[1] + r);
         if (c > c0 && c < c1 && r > r0 && r < r1) {
-          g(summaries_[k]);
+          g(start_[k + 1] - start_[k], summaries_[k]);
           continue;
         }
         for (std::size_t i = start_[k]; i < start_[k + 1]; ++i) {
@@ -1429,8 +1427,8 @@ computeRegionsOfInterest(const SegmentationResult& result,
           r.box_min = r.box_min.cwiseMin(x);
           r.box_max = r.box_max.cwiseMax(x);
         },
-        [&](const VertexGrid::Summary& cell) {
-          r.num_points += cell.count;
+        [&](std::size_t count, const VertexGrid::Summary& cell) {
+          r.num_points += count;
           r.box_min = r.box_min.cwiseMin(cell.min);
           r.box_max = r.box_max.cwiseMax(cell.max);
         });

@@ -87,8 +87,8 @@ struct MergeInput {
  * within max_edge_triangle_angle of N_Sk (valid edge, eq. 8), each unassigned seed at
  * its vertices joins S_k when its normal is within max_merge_angle of N_Sk (eq. 9-10).
  * N_Sk is the normalized sum of N_v / A_v (N_v A_v with segment_normal_weight = Area)
- * over its seeds (eq. 7), updated at every join. Each seed joins once and each triangle is examined at most once per leaf of
- * its vertices: linear in the mesh size.
+ * over its seeds (eq. 7), updated at every join. Each seed joins once and each triangle
+ * is examined at most once per leaf of its vertices: linear in the mesh size.
  *
  * With several threads and at least 1,024 leaves, the threads grow seeds ahead of
  * their turn, each over its own part of the leaves, and a segment so grown is kept

@@ -242,17 +242,18 @@ public:
    * per triangle are in getResult().mesh); empty before a successful extract(). */
   void getPolygonMesh(pcl::PolygonMesh& mesh) const;
 
-  /** \brief The triangulation of the last extract() or update(): the vertex of every input point,
-   * the vertices' representative points, angles and sensor-frame positions. Its
-   * neighbours are left empty: the triangle adjacency is getResult().mesh.neighbours
-   * (same triangle order), stored once. */
+  /** \brief The triangulation of the last extract() or update(): the vertex of every
+   * input point, the vertices' representative points, angles and sensor-frame
+   * positions. Its neighbours are left empty: the triangle adjacency is
+   * getResult().mesh.neighbours (same triangle order), stored once. */
   const SphericalTriangulation& getTriangulation() const
   {
     return delaunay_.getTriangulation();
   }
 
-  /** \brief The multi-resolution octree of the last extract() or update(), over the mesh vertices
-   * in the sensor frame (its point i is vertex i of getTriangulation()). */
+  /** \brief The multi-resolution octree of the last extract() or update(), over the
+   * mesh vertices in the sensor frame (its point i is vertex i of getTriangulation()).
+   */
   typename Octree::ConstPtr getOctree() const { return octree_; }
 
 protected:

@@ -249,10 +249,10 @@ private:
   DelaunayBackend backend_ = DelaunayBackend::Sweep;
   double angle_quantization_ = 1e-7;
   ViewProjection projection_ = ViewProjection::Forward;
-  /** Unaligned storage (as every member of the installed classes must be): Eigen aligns
-   * a 64-byte matrix to 16, 32 or 64 bytes depending on the compiler's -m flags (SSE,
-   * AVX, AVX-512), so an aligned member would give this class another layout in a
-   * program built with -march=native than in the library. */
+  /** Unaligned storage (as every 32- or 64-byte Eigen member of the installed classes
+   * must be): Eigen aligns a 64-byte matrix to 16, 32 or 64 bytes depending on the
+   * compiler's -m flags (SSE, AVX, AVX-512), so an aligned member would give this class
+   * another layout in a program built with -march=native than in the library. */
   Eigen::Transform<float, 3, Eigen::Affine, Eigen::DontAlign> sensor_pose_ =
       Eigen::Transform<float, 3, Eigen::Affine, Eigen::DontAlign>::Identity();
   bool has_sensor_pose_ = false;
