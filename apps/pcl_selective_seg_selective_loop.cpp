@@ -12,7 +12,8 @@
 // segmented and scored. Writes OUT/table.md, OUT/<scene>.dat (gnuplot), the clouds and
 // windows for the pictures (OUT/<scene>_*.pcd, *.json) and OUT/<scene>_min_voxel.txt.
 // Every file is written under a temporary name and renamed into place only when the
-// whole run succeeded: a failed run leaves OUT as it was (a folder it made, removed).
+// whole run succeeded: a failed run leaves OUT as it was (a folder it made, removed;
+// a run ended by a signal removes its temporaries but leaves such a folder, empty).
 //
 // Exit codes: 0 = success, 1 = runtime error, 2 = usage error.
 
@@ -28,6 +29,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
+#include <new>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -46,6 +48,11 @@ namespace {
 
 constexpr int kRuntimeError = 1;
 constexpr int kUsageError = 2;
+// -step_scale's range: the scans' points, memory and time grow as 1 / S^2 (the cube at
+// 0.25: about 30 s and 0.4 GB; at 0.1 it took 3 min and 2.4 GB, the door far more),
+// and from about 100 up a scan has too few points to segment.
+constexpr double kMinStepScale = 0.25;
+constexpr double kMaxStepScale = 100.0;
 
 struct Options {
   std::vector<std::string> scenes = {"cube", "chair", "door"};
@@ -85,30 +92,38 @@ printHelp(const char* program)
       "  -out FOLDER            where table.md, <scene>.dat, clouds and windows go "
       "(made if missing)\n"
       "  -scenes a,b            scenes among cube, chair, door (default all three)\n"
-      "  -iterations N          refinement rounds (default %d)\n"
+      "  -iterations N          refinement rounds, in [0, 100] (default %d)\n"
       "  -coarse_factor X       coarse step = X times the fine step, in [1, 100] "
       "(default %g)\n"
       "  -budget_fraction F     selective point budget, fraction of the finest uniform "
-      "scan's points (default %g)\n"
-      "  -range_noise K         range noise sigma = K r^2 [1/m] (default %g, "
+      "scan's points, coarse scan\n"
+      "                         included: in (0, 1], at least 1 / coarse_factor^2 "
+      "(default %g)\n"
+      "  -range_noise K         range noise sigma = K r^2 [1/m], in [0, 1] (default "
+      "%g, "
       "level A)\n"
-      "  -min_voxel_factor X    finest voxel = X fine steps at the median range; 0 = "
-      "automatic from the coarse scan (default %g)\n"
+      "  -min_voxel_factor X    finest voxel = X fine steps at the median range, in "
+      "[0, 1000]; 0 = automatic\n"
+      "                         from the coarse scan (default %g)\n"
       "  -progressive 0|1       1: each round a step finer, the last at the fine "
       "step; 0: every round at the fine step (default %g)\n"
       "  -window_steps X        evidence tiles of X coarse steps, in [0.01, 1000]; 0 = "
       "-roi_max_window_deg (default %g)\n"
-      "  -step_scale S          multiply every step by S (S > 1: a quicker, coarser "
-      "run; default %g)\n"
+      "  -step_scale S          multiply every step by S, in [0.25, 100]: points, "
+      "memory and time grow\n"
+      "                         as 1 / S^2 (S > 1: a quicker, coarser run; default "
+      "%g)\n"
       "  -seed N                the sensor's random seed (rays, dropouts, noise) for "
-      "every scan; default: the scene's own\n\n"
-      "The loop sets the regions' step (the fine step), point budget and yield; the "
-      "other\nregion options apply (the budget flags -roi_max_points, -roi_max_sr and "
-      "-roi_max_regions\nare refused: -budget_fraction sets the budget). The loop's "
-      "own "
-      "defaults differ from those\nlisted below: -roi_margin_spacings 0.5 "
-      "-roi_valid_edges 1 -roi_edge_on 1 -roi_side_deg 25 -roi_side_confidence 0.95\n"
-      "-roi_sparse_by_area 1:\n",
+      "every scan, in\n"
+      "                         [0, 4294967295]; default: the scene's own\n\n"
+      "The loop sets the windows' point budget (-budget_fraction, shared among the "
+      "rounds), step (a step\nfiner each round with -progressive 1, the fine step in "
+      "the last) and yield: -roi_max_points,\n-roi_max_sr, -roi_max_regions, "
+      "-roi_yield, -roi_step_deg and -roi_refine are refused, and\n"
+      "-roi_max_window_deg applies only with -window_steps 0. The loop's own defaults "
+      "differ from\nthose listed below: -roi_margin_spacings 0.5 -roi_valid_edges 1 "
+      "-roi_edge_on 1 -roi_side_deg 25\n-roi_side_confidence 0.95 "
+      "-roi_sparse_by_area 1.\n",
       program,
       defaults.iterations,
       defaults.coarse_factor,
@@ -118,9 +133,35 @@ printHelp(const char* program)
       defaults.progressive,
       defaults.window_steps,
       defaults.step_scale);
-  selseg_apps::printRegionHelp();
-  print_info("Segmentation (both strategies):\n");
+  selseg_apps::printRegionHelp(true);
+  print_info("The segmentation options apply to both strategies.\n");
   selseg_apps::printSegmentationHelp();
+}
+
+/** \a fraction rounded up to three significant digits. */
+double
+roundUp3(double fraction)
+{
+  const double unit = std::pow(10.0, std::floor(std::log10(fraction)) - 2.0);
+  return std::ceil(fraction / unit - 1e-9) * unit;
+}
+
+/** What to give when the budget cannot hold a coarse scan of \a coarse_share of the
+ * finest uniform scan's points: a fraction with a quarter to spare, or, where that
+ * would exceed the whole scan, a coarser coarse scan. */
+std::string
+budgetAdvice(double coarse_share)
+{
+  char text[160];
+  const double fraction = roundUp3(1.25 * coarse_share);
+  if (fraction <= 1.0)
+    std::snprintf(text, sizeof text, "give -budget_fraction %.3g or more", fraction);
+  else
+    std::snprintf(text,
+                  sizeof text,
+                  "give -coarse_factor 1.12 or more (a coarse scan of at most 80%% of "
+                  "the points leaves some for the windows)");
+  return text;
 }
 
 bool
@@ -160,6 +201,11 @@ parseOptions(int argc, char** argv, Options& opt)
     opt.scenes.clear();
     std::stringstream list(scenes);
     std::string name;
+    if (!scenes.empty() && scenes.back() == ',') {
+      print_error("-scenes '%s' ends with a comma: list scenes as a,b.\n",
+                  scenes.c_str());
+      return false;
+    }
     while (std::getline(list, name, ',')) {
       sim::PaperScene scene;
       if (!sim::parsePaperScene(name, scene)) {
@@ -177,16 +223,20 @@ parseOptions(int argc, char** argv, Options& opt)
       return false;
     }
   }
-  for (const char* flag : {"-roi_max_points", "-roi_max_sr", "-roi_max_regions"})
-    if (find_argument(argc, argv, flag) >= 0) {
-      print_error(
-          "%s does not apply here: the loop's budget is -budget_fraction of the "
-          "finest uniform scan's points.\n",
-          flag);
+  // The loop sets these region parameters itself, every round: a value given for them
+  // would change nothing (and be written into the windows' files as if it had).
+  for (const std::string& flag : selseg_apps::loopSetRegionFlags())
+    if (find_argument(argc, argv, flag.c_str()) >= 0) {
+      print_error("%s does not apply here: the loop sets the windows' point budget "
+                  "(-budget_fraction of the finest uniform scan's points, shared "
+                  "among the rounds), step and yield itself.\n",
+                  flag.c_str());
       return false;
     }
   using selseg_apps::parseNumber;
-  if (!parseNumber(argc, argv, "-iterations", opt.iterations) ||
+  double iterations = opt.iterations;
+  const bool seed_given = find_argument(argc, argv, "-seed") >= 0;
+  if (!parseNumber(argc, argv, "-iterations", iterations) ||
       !parseNumber(argc, argv, "-coarse_factor", opt.coarse_factor) ||
       !parseNumber(argc, argv, "-budget_fraction", opt.budget_fraction) ||
       !parseNumber(argc, argv, "-range_noise", opt.range_noise) ||
@@ -208,24 +258,82 @@ parseOptions(int argc, char** argv, Options& opt)
                 "-min_voxel_factor, the uniform scans choose theirs.\n");
     return false;
   }
-  if (opt.iterations < 0 || opt.iterations > 100 ||
-      !(opt.coarse_factor >= 1.0 && opt.coarse_factor <= 100.0) ||
-      !(opt.budget_fraction > 0.0 && opt.budget_fraction <= 1.0) ||
-      !(opt.range_noise >= 0.0 && opt.range_noise <= 1.0) ||
-      !(opt.min_voxel_factor >= 0.0) || !(opt.step_scale > 0.0) ||
-      !(opt.window_steps == 0.0 ||
-        (opt.window_steps >= 0.01 && opt.window_steps <= 1000.0)) ||
-      (opt.progressive != 0.0 && opt.progressive != 1.0) ||
-      !(opt.seed < 0.0 ||
-        (opt.seed <= 4294967295.0 && opt.seed == std::floor(opt.seed)))) {
+  // Each option's range, named with the option (the first one out of range is
+  // reported).
+  const bool whole_iterations = iterations == std::floor(iterations);
+  const struct {
+    const char* flag;
+    bool ok;
+    const char* range;
+  } ranges[] = {
+      {"-iterations",
+       whole_iterations && iterations >= 0 && iterations <= 100,
+       "a whole number in [0, 100]"},
+      {"-coarse_factor",
+       opt.coarse_factor >= 1.0 && opt.coarse_factor <= 100.0,
+       "a value in [1, 100]"},
+      {"-budget_fraction",
+       opt.budget_fraction > 0.0 && opt.budget_fraction <= 1.0,
+       "a value in (0, 1]"},
+      {"-range_noise",
+       opt.range_noise >= 0.0 && opt.range_noise <= 1.0,
+       "a value in [0, 1]"},
+      {"-min_voxel_factor",
+       opt.min_voxel_factor >= 0.0 && opt.min_voxel_factor <= 1000.0,
+       "0 or a value in (0, 1000]"},
+      {"-step_scale",
+       opt.step_scale >= kMinStepScale && opt.step_scale <= kMaxStepScale,
+       "a value in [0.25, 100] (the scans' points grow as 1 / S^2)"},
+      {"-window_steps",
+       opt.window_steps == 0.0 ||
+           (opt.window_steps >= 0.01 && opt.window_steps <= 1000.0),
+       "0 or a value in [0.01, 1000]"},
+      {"-progressive", opt.progressive == 0.0 || opt.progressive == 1.0, "0 or 1"},
+      {"-seed",
+       !seed_given || (opt.seed >= 0.0 && opt.seed <= 4294967295.0 &&
+                       opt.seed == std::floor(opt.seed)),
+       "a whole number in [0, 4294967295]"},
+  };
+  for (const auto& r : ranges)
+    if (!r.ok) {
+      print_error("Option %s needs %s.\n", r.flag, r.range);
+      return false;
+    }
+  opt.iterations = static_cast<int>(iterations);
+  if (!seed_given)
+    opt.seed = -1.0;
+  if (opt.window_steps > 0.0 && find_argument(argc, argv, "-roi_max_window_deg") >= 0) {
+    print_error("-roi_max_window_deg applies only with -window_steps 0: otherwise the "
+                "evidence tiles, -window_steps coarse steps, bound the windows.\n");
+    return false;
+  }
+  // The budget includes the coarse scan, about 1 / coarse_factor^2 of the finest
+  // uniform scan's points: a smaller fraction cannot hold it, whatever the scene.
+  const double coarse_share = 1.0 / (opt.coarse_factor * opt.coarse_factor);
+  if (opt.budget_fraction < coarse_share) {
     print_error(
-        "Need 0 <= iterations <= 100, 1 <= coarse_factor <= 100, 0 < "
-        "budget_fraction <= 1, 0 <= range_noise <= 1, min_voxel_factor >= 0, "
-        "step_scale > 0, window_steps 0 or in [0.01, 1000], progressive 0 or 1, "
-        "seed a whole number < 2^32.\n");
+        "-budget_fraction %g is less than the coarse scan's share of the finest "
+        "uniform scan's points, about 1 / coarse_factor^2 = %.3g: %s.\n",
+        opt.budget_fraction,
+        coarse_share,
+        budgetAdvice(coarse_share).c_str());
     return false;
   }
   return true;
+}
+
+/** \a sum / \a count metres in millimetres, two decimals; "-" for an empty group and
+ * for a distance that is not a number (a scan segmented as a single segment has no
+ * predicted boundary to measure to). */
+std::string
+meanMm(double sum, std::size_t count)
+{
+  const double mean = sum / static_cast<double>(count);
+  if (count == 0 || !std::isfinite(mean))
+    return "-";
+  char text[32];
+  std::snprintf(text, sizeof text, "%.2f", 1000.0 * mean);
+  return text;
 }
 
 /** One row of a .dat file. */
@@ -250,26 +358,26 @@ tableRow(const std::string& scene,
          std::size_t dense_points)
 {
   char line[512];
-  std::snprintf(
-      line,
-      sizeof(line),
-      "| %s | %s | %zu | %.0f%% | %.3f | %.2f | %.2f | %.2f | %zu | %zu/%zu/%zu/"
-      "%zu/%zu | %.2f%% |\n",
-      scene.c_str(),
-      strategy.c_str(),
-      s.points,
-      100.0 * static_cast<double>(s.points) / static_cast<double>(dense_points),
-      s.seconds,
-      1000.0 * s.accuracy.mean,
-      1000.0 * s.accuracy.p90,
-      1000.0 * s.spurious.mean,
-      s.segments,
-      s.hoover.correct_detections,
-      s.hoover.over_segmentations,
-      s.hoover.under_segmentations,
-      s.hoover.missed,
-      s.hoover.noise,
-      100.0 * s.under_segmentation);
+  std::snprintf(line,
+                sizeof(line),
+                "| %s | %s | %zu | %.0f%% | %.3f | %s | %s | %s | %zu | %zu/%zu/%zu/"
+                "%zu/%zu | %.2f%% |\n",
+                scene.c_str(),
+                strategy.c_str(),
+                s.points,
+                100.0 * static_cast<double>(s.points) /
+                    static_cast<double>(dense_points),
+                s.seconds,
+                meanMm(s.accuracy.mean, 1).c_str(),
+                meanMm(s.accuracy.p90, 1).c_str(),
+                meanMm(s.spurious.mean, 1).c_str(),
+                s.segments,
+                s.hoover.correct_detections,
+                s.hoover.over_segmentations,
+                s.hoover.under_segmentations,
+                s.hoover.missed,
+                s.hoover.noise,
+                100.0 * s.under_segmentation);
   return line;
 }
 
@@ -289,12 +397,21 @@ savePcd(selseg_apps::OutputTransaction& outputs,
   return ok;
 }
 
-/** \a fraction rounded up to three significant digits. */
-double
-roundUp3(double fraction)
+/** With a -step_scale other than 1, a hint that it may be the cause of a failed scan.
+ */
+std::string
+scaleHint(const Options& opt)
 {
-  const double unit = std::pow(10.0, std::floor(std::log10(fraction)) - 2.0);
-  return std::ceil(fraction / unit - 1e-9) * unit;
+  if (opt.step_scale == 1.0)
+    return "";
+  char text[160];
+  std::snprintf(
+      text,
+      sizeof text,
+      " (-step_scale %g scales every step: a scan of too few points, or of too "
+      "many, fails; try a value closer to 1)",
+      opt.step_scale);
+  return text;
 }
 
 /** Run one scene; appends its rows to \a table and stages its files in \a outputs. */
@@ -315,7 +432,8 @@ runScene(const Options& opt,
 
   sim::ReferenceBoundary reference;
   if (!sim::makeReferenceBoundary(setup, 0.5 * fine, reference)) {
-    print_error("%s: the reference scan failed.\n", name.c_str());
+    print_error(
+        "%s: the reference scan failed.%s\n", name.c_str(), scaleHint(opt).c_str());
     return false;
   }
   print_info("%s: reference scan %zu points, %zu ground-truth boundary points\n",
@@ -331,7 +449,10 @@ runScene(const Options& opt,
     sim::ScanScore s;
     pcl::PointCloud<pcl::PointXYZL> cloud;
     if (!sim::runUniformScan(setup, f * fine, seg_params, reference, s, &cloud)) {
-      print_error("%s: the uniform scan at %g rad failed.\n", name.c_str(), f * fine);
+      print_error("%s: the uniform scan at %g rad failed.%s\n",
+                  name.c_str(),
+                  f * fine,
+                  scaleHint(opt).c_str());
       return false;
     }
     uniform.push_back(s);
@@ -352,19 +473,19 @@ runScene(const Options& opt,
   loop.point_budget =
       static_cast<std::size_t>(opt.budget_fraction * static_cast<double>(dense_points));
   // The budget includes the coarse scan, about 1 / coarse_factor^2 of the finest
-  // uniform scan's points (whether a fraction is too small depends on the scene).
+  // uniform scan's points (parseOptions() refused smaller fractions; the point count's
+  // rounding can still fall short of it).
   const double coarse_share = 1.0 / (opt.coarse_factor * opt.coarse_factor);
   if (static_cast<double>(loop.point_budget) <
       coarse_share * static_cast<double>(dense_points)) {
     print_error("%s: -budget_fraction %g of the finest uniform scan's %zu points is a "
-                "budget of %zu points, less than the coarse scan's (about %.0f): give "
-                "-budget_fraction %.3g or more.\n",
+                "budget of %zu points, less than the coarse scan's (about %.0f): %s.\n",
                 name.c_str(),
                 opt.budget_fraction,
                 dense_points,
                 loop.point_budget,
                 coarse_share * static_cast<double>(dense_points),
-                roundUp3(1.25 * coarse_share));
+                budgetAdvice(coarse_share).c_str());
     return false;
   }
   std::vector<RegionOfInterest> scanned;
@@ -378,6 +499,7 @@ runScene(const Options& opt,
   for (const auto& p : reference.points)
     truth_angles.emplace_back(std::atan2(p.x, p.z), std::atan2(p.y, p.z));
   std::vector<char> truth_covered(truth_angles.size(), 0);
+  pcl::selective_seg::RegionOfInterestParameters last_parameters = loop.regions;
   const auto observer = [&](const sim::LoopRound& r) {
     min_voxel = r.result->min_voxel_size;
     const auto& regions = *r.regions;
@@ -407,20 +529,22 @@ runScene(const Options& opt,
           files_ok && savePcd(outputs, base + "_coarse.pcd", *r.cloud) &&
           selseg_apps::writeRegionsJson(outputs.stage(base + "_coarse_rois.json"),
                                         name,
-                                        loop.regions,
+                                        r.region_parameters,
                                         stats,
                                         regions);
     }
     scanned.insert(scanned.end(), regions.begin(), regions.end());
+    if (!regions.empty())
+      last_parameters = r.region_parameters;
     if (regions.empty() || r.iteration == opt.iterations)
       files_ok = files_ok && savePcd(outputs, base + "_refined.pcd", *r.cloud);
-    print_info("%s: round %d, %zu points, boundary accuracy %.2f mm; evidence "
+    print_info("%s: round %d, %zu points, boundary accuracy %s mm; evidence "
                "%zu/%zu/%zu vertices (transition/small/sparse), %zu candidate windows, "
                "%zu already fine, %zu over budget, %zu chosen (%zu points estimated)\n",
                name.c_str(),
                r.iteration,
                r.score.points,
-               1000.0 * r.score.accuracy.mean,
+               meanMm(r.score.accuracy.mean, 1).c_str(),
                stats.transition_vertices,
                stats.small_segment_vertices,
                stats.sparse_vertices,
@@ -431,7 +555,8 @@ runScene(const Options& opt,
                stats.selected_points);
   };
   if (!sim::runSelectiveLoop(setup, loop, reference, rounds, observer)) {
-    print_error("%s: the selective loop failed.\n", name.c_str());
+    print_error(
+        "%s: the selective loop failed.%s\n", name.c_str(), scaleHint(opt).c_str());
     return false;
   }
   {
@@ -445,19 +570,18 @@ runScene(const Options& opt,
       n_in += truth_covered[i] != 0;
     }
     const std::size_t n_out = truth_angles.size() - n_in;
-    print_info(
-        "%s: %zu of %zu true edge points (%.0f%%) inside a scanned window; mean "
-        "distance there %.2f mm (finest uniform) / %.2f mm (selective), outside "
-        "%.2f / %.2f mm\n",
-        name.c_str(),
-        n_in,
-        truth_angles.size(),
-        100.0 * static_cast<double>(n_in) /
-            static_cast<double>(std::max<std::size_t>(truth_angles.size(), 1)),
-        1000.0 * inside[0] / static_cast<double>(std::max<std::size_t>(n_in, 1)),
-        1000.0 * inside[1] / static_cast<double>(std::max<std::size_t>(n_in, 1)),
-        1000.0 * outside[0] / static_cast<double>(std::max<std::size_t>(n_out, 1)),
-        1000.0 * outside[1] / static_cast<double>(std::max<std::size_t>(n_out, 1)));
+    print_info("%s: %zu of %zu true edge points (%.0f%%) inside a scanned window; mean "
+               "distance there %s mm (finest uniform) / %s mm (selective), outside "
+               "%s / %s mm\n",
+               name.c_str(),
+               n_in,
+               truth_angles.size(),
+               100.0 * static_cast<double>(n_in) /
+                   static_cast<double>(std::max<std::size_t>(truth_angles.size(), 1)),
+               meanMm(inside[0], n_in).c_str(),
+               meanMm(inside[1], n_in).c_str(),
+               meanMm(outside[0], n_out).c_str(),
+               meanMm(outside[1], n_out).c_str());
   }
   {
     // The same by the kind of true edge (metrics::describeBoundaryPoints()): depth
@@ -489,15 +613,14 @@ runScene(const Options& opt,
     std::string line;
     for (int c = 0; c < 5; ++c) {
       char buffer[160];
-      const double n = static_cast<double>(std::max<std::size_t>(count[c], 1));
       std::snprintf(buffer,
                     sizeof buffer,
-                    "%s%s %zu, %.2f / %.2f mm",
+                    "%s%s %zu, %s / %s mm",
                     c ? "; " : "",
                     names[c],
                     count[c],
-                    1000.0 * sum[c][0] / n,
-                    1000.0 * sum[c][1] / n);
+                    meanMm(sum[c][0], count[c]).c_str(),
+                    meanMm(sum[c][1], count[c]).c_str());
       line += buffer;
     }
     print_info("%s: true edge points by kind (merge angle %.0f deg), mean distance "
@@ -506,12 +629,17 @@ runScene(const Options& opt,
                merge_deg,
                line.c_str());
   }
+  // Every round's windows: the budget recorded is the loop's (all rounds, the coarse
+  // scan included) and the step its finest; the other parameters are the last
+  // round's that chose windows.
   pcl::selective_seg::RegionOfInterestStats all;
   all.selected = scanned.size();
+  pcl::selective_seg::RegionOfInterestParameters whole = last_parameters;
+  whole.max_points = loop.point_budget;
+  whole.target_step = loop.fine_step;
   files_ok =
-      files_ok &&
-      selseg_apps::writeRegionsJson(
-          outputs.stage(base + "_windows.json"), name, loop.regions, all, scanned);
+      files_ok && selseg_apps::writeRegionsJson(
+                      outputs.stage(base + "_windows.json"), name, whole, all, scanned);
   // Where the error is: every reference boundary point with its distance to the
   // nearest predicted boundary, for the finest uniform scan and the last round.
   std::ofstream errors(outputs.stage(base + "_boundary_errors.dat"));
@@ -563,14 +691,46 @@ runScene(const Options& opt,
   return true;
 }
 
-} // namespace
+/** Where -h or --help stands as an option (not as another option's value). */
+bool
+helpAsked(int argc, char** argv)
+{
+  for (int i = 1; i < argc; i += 2)
+    if (std::string(argv[i]) == "-h" || std::string(argv[i]) == "--help")
+      return true;
+  return false;
+}
+
+/** Every file a run writes for \a scenes under \a folder. */
+std::vector<std::string>
+outputFiles(const std::string& folder, const std::vector<std::string>& scenes)
+{
+  std::vector<std::string> files;
+  for (const auto& scene : scenes)
+    for (const char* suffix : {"_dense.pcd",
+                               "_coarse.pcd",
+                               "_coarse_rois.json",
+                               "_refined.pcd",
+                               "_windows.json",
+                               "_boundary_errors.dat",
+                               "_min_voxel.txt",
+                               ".dat"})
+      files.push_back(folder + "/" + scene + suffix);
+  files.push_back(folder + "/table.md");
+  return files;
+}
 
 int
-main(int argc, char** argv)
+run(int argc, char** argv)
 {
-  if (argc < 2 || find_switch(argc, argv, "-h") || find_switch(argc, argv, "--help")) {
+  if (argc < 2) {
     printHelp(argv[0]);
-    return argc < 2 ? kUsageError : 0;
+    print_error("Give -out FOLDER.\n");
+    return kUsageError;
+  }
+  if (helpAsked(argc, argv)) {
+    printHelp(argv[0]);
+    return 0;
   }
   Options opt;
   // The loop's windows (sim::loopRegionParameters()); the flags change them.
@@ -613,6 +773,15 @@ main(int argc, char** argv)
       "(mm) "
       "| p90 (mm) | spurious, mean (mm) | segments | correct/over/under/missed/noise "
       "| under-seg. error |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
+  // Every output can be written, before the scans (a folder or a FIFO in its place,
+  // a folder that takes no file).
+  for (const auto& file : outputFiles(opt.out, opt.scenes)) {
+    std::string error;
+    if (!selseg_apps::outputWritable(file, error)) {
+      print_error("%s\n", error.c_str());
+      return kRuntimeError;
+    }
+  }
   // Declared after remove_made: its temporaries go before the folders.
   selseg_apps::OutputTransaction outputs;
   for (const auto& scene : opt.scenes)
@@ -633,4 +802,19 @@ main(int argc, char** argv)
   succeeded = true;
   print_info("%s", table.c_str());
   return 0;
+}
+
+} // namespace
+
+int
+main(int argc, char** argv)
+{
+  // Out of memory (a small -step_scale on a small machine): a message, and the
+  // temporaries and the folders the run made are removed on the way out of run().
+  try {
+    return run(argc, argv);
+  } catch (const std::bad_alloc&) {
+    print_error("Out of memory: use a larger -step_scale or fewer -scenes.\n");
+    return kRuntimeError;
+  }
 }

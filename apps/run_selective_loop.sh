@@ -16,6 +16,11 @@ if [ ! -x "$loop_tool" ]; then
   echo "$0: no $loop_tool: give the build folder of a built checkout" >&2
   exit 2
 fi
+# The plots need gnuplot: checked before the 32 loop runs (minutes), not after them.
+if ! command -v gnuplot > /dev/null; then
+  echo "$0: gnuplot not found: install it (apt-get install gnuplot-nox)" >&2
+  exit 2
+fi
 mkdir -p "$out" "$images"
 
 "$loop_tool" -out "$out" | tee "$out/log.txt"

@@ -39,23 +39,45 @@ regionFlags()
   return flags;
 }
 
+const std::vector<std::string>&
+loopSetRegionFlags()
+{
+  static const std::vector<std::string> flags = {"-roi_max_sr",
+                                                 "-roi_max_points",
+                                                 "-roi_max_regions",
+                                                 "-roi_yield",
+                                                 "-roi_step_deg",
+                                                 "-roi_refine"};
+  return flags;
+}
+
 void
-printRegionHelp()
+printRegionHelp(bool for_loop)
 {
   const pcl::selective_seg::RegionOfInterestParameters d;
+  if (for_loop)
+    pcl::console::print_info("Regions of interest:\n");
+  else
+    pcl::console::print_info(
+        "Regions of interest (with -roi_json; budgets of 0 = no limit):\n"
+        "  -roi_max_sr X            total solid angle of the chosen windows [sr] "
+        "(default %g)\n"
+        "  -roi_max_points N        total estimated points of the chosen windows "
+        "(default %zu)\n"
+        "  -roi_max_regions N       number of windows (default %zu)\n"
+        "  -roi_yield F             fraction of the rays that return a point, for the "
+        "estimate (default %g)\n"
+        "  -roi_step_deg X          angular step of the finer scan; 0 = current "
+        "spacing / -roi_refine (default %g)\n"
+        "  -roi_refine X            refinement of the step when -roi_step_deg is 0 "
+        "(default %g)\n",
+        d.max_solid_angle,
+        d.max_points,
+        d.max_regions,
+        d.sample_yield,
+        d.target_step / kDeg,
+        d.refinement_factor);
   pcl::console::print_info(
-      "Regions of interest (with -roi_json; budgets of 0 = no limit):\n"
-      "  -roi_max_sr X            total solid angle of the chosen windows [sr] "
-      "(default %g)\n"
-      "  -roi_max_points N        total estimated points of the chosen windows "
-      "(default %zu)\n"
-      "  -roi_max_regions N       number of windows (default %zu)\n"
-      "  -roi_yield F             fraction of the rays that return a point, for the "
-      "estimate (default %g)\n"
-      "  -roi_step_deg X          angular step of the finer scan; 0 = current "
-      "spacing / -roi_refine (default %g)\n"
-      "  -roi_refine X            refinement of the step when -roi_step_deg is 0 "
-      "(default %g)\n"
       "  -roi_min_refinement X    windows (and, with -roi_step_deg, evidence) "
       "sampled within X times the\n"
       "                           suggested step already are left out (default %g)\n"
@@ -97,12 +119,6 @@ printRegionHelp()
       "invalid edges, leaves, valid\n"
       "                           edges, and of small-segment and sparse evidence "
       "(default %g,%g,%g,%g,%g)\n\n",
-      d.max_solid_angle,
-      d.max_points,
-      d.max_regions,
-      d.sample_yield,
-      d.target_step / kDeg,
-      d.refinement_factor,
       d.min_refinement,
       d.max_window_size / kDeg,
       d.min_window_size / kDeg,

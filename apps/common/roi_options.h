@@ -16,8 +16,13 @@ namespace selseg_apps {
 /** \brief The flags of the region-of-interest parameters (each takes a value). */
 const std::vector<std::string>& regionFlags();
 
-/** \brief Print their help lines, with units and defaults. */
-void printRegionHelp();
+/** \brief The region flags whose values the selective loop sets itself (the budgets,
+ * the yield and the step): it refuses them. */
+const std::vector<std::string>& loopSetRegionFlags();
+
+/** \brief Print their help lines, with units and defaults; \a for_loop leaves out
+ * loopSetRegionFlags(). */
+void printRegionHelp(bool for_loop = false);
 
 /** \brief Read those flags into \a params (degrees on the command line, radians in the
  * struct) and validate the result.

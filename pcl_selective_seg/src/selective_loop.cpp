@@ -309,8 +309,8 @@ runSelectiveLoop(const SimulationSetup& setup,
       return fail("scoring failed (reason above)");
     regions.clear();
     stats = RegionOfInterestStats();
+    RegionOfInterestParameters roi = params.regions;
     if (round < params.iterations && score.points < params.point_budget) {
-      RegionOfInterestParameters roi = params.regions;
       // Progressive: round r + 1 of n refines to coarse x (fine / coarse)^((r + 1) /
       // n).
       roi.target_step =
@@ -378,6 +378,7 @@ runSelectiveLoop(const SimulationSetup& setup,
       r.result = &seg.getResult();
       r.regions = &regions;
       r.region_stats = stats;
+      r.region_parameters = roi;
       r.score = score;
       observer(r);
     }

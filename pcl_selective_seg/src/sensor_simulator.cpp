@@ -725,6 +725,13 @@ SensorSimulator::isInHole(double theta, double phi) const
   for (const auto& hole : holes_) {
     const double dt = theta - hole.theta;
     const double dp = phi - hole.phi;
+    // A point of the ellipse lies within its larger semi-axis of the centre: a ray
+    // farther in either angle is outside, without the rotation's cosine and sine
+    // (most rays, for most holes). The margin keeps the exact test's answer wherever
+    // its rounding could differ.
+    const double reach = std::max(hole.semi_axis_a, hole.semi_axis_b) * (1.0 + 1e-9);
+    if (std::abs(dt) > reach || std::abs(dp) > reach)
+      continue;
     const double c = std::cos(hole.orientation);
     const double s = std::sin(hole.orientation);
     const double x = (c * dt + s * dp) / hole.semi_axis_a;

@@ -681,6 +681,65 @@ TEST_F(ToolFailure, CompareToolChecksItsCommandLineAndTable)
 // signal (exit status 128 + its number). Each signal is sent once a temporary exists;
 // a run that ends before one is seen is not counted, and the test is skipped when no
 // run was caught writing.
+/** Runs \a args (the program first) with the default signal actions and its output
+ * to /dev/null, and sends \a sig once a file with ".tmp" in its name appears in
+ * \a folder. \return whether the signal was sent before the run ended; \a status is
+ * the run's wait status. A run of more than 120 s is killed and fails the test. */
+bool
+signalWhileWriting(const std::vector<std::string>& args,
+                   const fs::path& folder,
+                   int sig,
+                   int& status)
+{
+  const auto temporaryExists = [&] {
+    for (const auto& e : fs::directory_iterator(folder))
+      if (e.path().filename().string().find(".tmp") != std::string::npos)
+        return true;
+    return false;
+  };
+  std::vector<char*> argv;
+  for (const auto& a : args)
+    argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  const pid_t pid = ::fork();
+  if (pid < 0) {
+    ADD_FAILURE() << "fork failed";
+    return false;
+  }
+  if (pid == 0) {
+    // The default actions, whatever this process inherited (a shell's background
+    // job ignores SIGINT).
+    for (const int s : {SIGTERM, SIGINT, SIGHUP})
+      std::signal(s, SIG_DFL);
+    const int null = ::open("/dev/null", O_WRONLY);
+    ::dup2(null, 1);
+    ::dup2(null, 2);
+    ::execv(argv[0], argv.data());
+    ::_exit(127);
+  }
+  status = 0;
+  bool ended = false, seen = false;
+  const auto start = std::chrono::steady_clock::now();
+  while (!ended && !seen) {
+    ended = ::waitpid(pid, &status, WNOHANG) == pid;
+    seen = !ended && temporaryExists();
+    if (!ended && !seen) {
+      if (std::chrono::steady_clock::now() - start > std::chrono::seconds(120)) {
+        ::kill(pid, SIGKILL);
+        ::waitpid(pid, &status, 0);
+        ADD_FAILURE() << "the tool ran for more than 120 s";
+        return false;
+      }
+      ::usleep(500);
+    }
+  }
+  if (!seen)
+    return false;
+  ::kill(pid, sig);
+  EXPECT_EQ(::waitpid(pid, &status, 0), pid);
+  return !(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+}
+
 TEST_F(ToolFailure, SignalsLeaveNoTemporaries)
 {
   if (simulate.empty() || !fs::exists(simulate))
@@ -693,56 +752,13 @@ TEST_F(ToolFailure, SignalsLeaveNoTemporaries)
   const fs::path out = dir / "out";
   const std::string labels = (out / "labels.pcd").string();
   const std::string mesh = (out / "mesh.ply").string();
-  const auto temporaryExists = [&] {
-    for (const auto& e : fs::directory_iterator(out))
-      if (e.path().filename().string().find(".tmp") != std::string::npos)
-        return true;
-    return false;
-  };
   int caught = 0;
   for (const int sig : {SIGTERM, SIGINT, SIGHUP}) {
     for (const auto& e : fs::directory_iterator(out))
       fs::remove_all(e.path());
-    const pid_t pid = ::fork();
-    ASSERT_GE(pid, 0);
-    if (pid == 0) {
-      // The default actions, whatever this process inherited (a shell's background
-      // job ignores SIGINT).
-      for (const int s : {SIGTERM, SIGINT, SIGHUP})
-        std::signal(s, SIG_DFL);
-      const int null = ::open("/dev/null", O_WRONLY);
-      ::dup2(null, 1);
-      ::dup2(null, 2);
-      const char* argv[] = {tool.c_str(),
-                            big.c_str(),
-                            "-o",
-                            labels.c_str(),
-                            "-mesh_ply",
-                            mesh.c_str(),
-                            nullptr};
-      ::execv(tool.c_str(), const_cast<char* const*>(argv));
-      ::_exit(127);
-    }
     int status = 0;
-    bool ended = false, seen = false;
-    const auto start = std::chrono::steady_clock::now();
-    while (!ended && !seen) {
-      ended = ::waitpid(pid, &status, WNOHANG) == pid;
-      seen = !ended && temporaryExists();
-      if (!ended && !seen) {
-        if (std::chrono::steady_clock::now() - start > std::chrono::seconds(120)) {
-          ::kill(pid, SIGKILL);
-          ::waitpid(pid, &status, 0);
-          FAIL() << "the tool ran for more than 120 s";
-        }
-        ::usleep(500);
-      }
-    }
-    if (seen) {
-      ::kill(pid, sig);
-      ASSERT_EQ(::waitpid(pid, &status, 0), pid);
-    }
-    if (!seen || (WIFEXITED(status) && WEXITSTATUS(status) == 0))
+    if (!signalWhileWriting(
+            {tool, big.string(), "-o", labels, "-mesh_ply", mesh}, out, sig, status))
       continue; // it ended before the signal: nothing to check
     ++caught;
     EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == sig)
@@ -751,6 +767,38 @@ TEST_F(ToolFailure, SignalsLeaveNoTemporaries)
     EXPECT_TRUE(outputs().empty())
         << "signal " << sig << ": " << outputs().size() << " files left, the first "
         << (outputs().empty() ? "" : outputs()[0]);
+  }
+  if (caught == 0)
+    GTEST_SKIP() << "every run ended before a temporary file was seen";
+}
+
+// The simulator wrote "OUT.tmp" and renamed it: a signal during the write left it (a
+// 261 MB file in the review of session 28). It now stages its output as the other
+// tools do.
+TEST_F(ToolFailure, SimulatorSignalLeavesNoTemporary)
+{
+  if (simulate.empty() || !fs::exists(simulate))
+    GTEST_SKIP() << "pcl_selective_seg_simulate missing";
+  const fs::path out = dir / "out";
+  int caught = 0;
+  for (int attempt = 0; attempt < 3 && caught == 0; ++attempt) {
+    int status = 0;
+    if (!signalWhileWriting({simulate,
+                             "-scene",
+                             "door",
+                             "-density",
+                             "20",
+                             "-o",
+                             (out / "door.pcd").string()},
+                            out,
+                            SIGTERM,
+                            status))
+      continue;
+    ++caught;
+    EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM)
+        << "status " << status;
+    EXPECT_TRUE(outputs().empty()) << outputs().size() << " files left, the first "
+                                   << (outputs().empty() ? "" : outputs()[0]);
   }
   if (caught == 0)
     GTEST_SKIP() << "every run ended before a temporary file was seen";

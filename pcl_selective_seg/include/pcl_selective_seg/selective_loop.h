@@ -134,6 +134,10 @@ struct LoopRound {
    * computeRegionsOfInterest() that the points acquired so far left room for). */
   const std::vector<RegionOfInterest>* regions = nullptr;
   RegionOfInterestStats region_stats; ///< of computeRegionsOfInterest() this round
+  /** The parameters computeRegionsOfInterest() ran with this round: the loop's
+   * regions with the round's step, point budget, yield and window size (the loop's
+   * regions as given when it did not run: the last round, or no budget left). */
+  RegionOfInterestParameters region_parameters;
   ScanScore score;
 };
 
