@@ -144,6 +144,32 @@ TEST(MeshNormals, DegenerateTriangles)
   expectVectorNear(normals[2], Eigen::Vector3f(0.f, 0.f, -1.f));
 }
 
+TEST(MeshNormals, FlatnessBoundIsTwiceFloatRoundingOfTheLargestCorner)
+{
+  // The documented bound: a triangle whose height on its longest edge is at most
+  // 2 FLT_EPSILON max |corner| has no normal. Corners (0, 0, 2), (0.25, h, 2) and
+  // (0.5, 0, 2): the longest edge lies on the x axis, so the height is h exactly, and
+  // max |corner| = |(0.5, 0, 2)|. h = 1.5 of the unit: degenerate; 2.5: a normal.
+  const double unit = std::numeric_limits<float>::epsilon() * std::sqrt(0.25 + 4.0);
+  for (const double k : {1.5, 2.5}) {
+    const Vector3fVector positions{
+        {0.f, 0.f, 2.f}, {0.25f, static_cast<float>(k * unit), 2.f}, {0.5f, 0.f, 2.f}};
+    Vector3fVector normals;
+    std::vector<double> areas;
+    std::vector<std::uint8_t> edge_on;
+    pcl::selective_seg::computeTriangleNormalsAndEdgeOn(positions,
+                                                        {{0, 1, 2}},
+                                                        Eigen::Vector3f::Zero(),
+                                                        M_PI / 2.0,
+                                                        normals,
+                                                        areas,
+                                                        edge_on);
+    ASSERT_EQ(normals.size(), 1u);
+    EXPECT_EQ(normals[0].allFinite(), k > 2.0) << k << " units high";
+    EXPECT_NEAR(areas[0], 0.5 * 0.5 * static_cast<float>(k * unit), 1e-20);
+  }
+}
+
 TEST(MeshNormals, TrianglesFlatAtFloatPrecisionAreDegenerate)
 {
   // Three points of a line in 3-D, rounded to float: a triangle of non-zero area whose

@@ -423,6 +423,42 @@ TEST(OctreePointCloudNormalVariance, MeanNormalFrameSigmasOnAFloor)
   EXPECT_NEAR(sensor_frame->getAdaptiveLeaves()[0].sigma_theta, expected, 1e-6);
 }
 
+TEST(OctreePointCloudNormalVariance, MeanNormalFrameSigmasOnAWallAlongX)
+{
+  // The floor above turned 90 deg about z: a wall whose mean normal lies along the
+  // sensor's x axis, reversed m = (cos a, +-sin a, 0) and (cos a, 0, +-sin a). The
+  // frame's reference axis must then be y (x projects to nothing: both sigmas were
+  // 0, a voxel that never splits): u = y, v = z, and by the same hand computation
+  // sigma_theta = sigma_phi = a / sqrt(2) = 2.83 deg.
+  const double a = 4.0 * kDeg;
+  Scene scene;
+  const std::vector<Eigen::Vector3d> m{{std::cos(a), std::sin(a), 0.0},
+                                       {std::cos(a), -std::sin(a), 0.0},
+                                       {std::cos(a), 0.0, std::sin(a)},
+                                       {std::cos(a), 0.0, -std::sin(a)}};
+  for (std::size_t k = 0; k < m.size(); ++k)
+    scene.add(Eigen::Vector3f(2.f, 0.1f * k, 1.f), -m[k].cast<float>(), 1.0);
+  const auto octree = buildInMeanNormalFrame(scene, 0.01, M_PI);
+  ASSERT_EQ(octree->getAdaptiveLeaves().size(), 1u);
+  const AdaptiveLeaf& leaf = octree->getAdaptiveLeaves()[0];
+  EXPECT_NEAR(leaf.sigma_theta, a / std::sqrt(2.0), 1e-6);
+  EXPECT_NEAR(leaf.sigma_phi, a / std::sqrt(2.0), 1e-6);
+  EXPECT_NEAR(leaf.normal.x(), -1.f, 1e-6f);
+  // At 2 deg the root splits when its four points may be split (the default minimum
+  // is 8; its children, of two points each, may not).
+  EXPECT_EQ(buildOctree(scene,
+                        0.01,
+                        2.0 * kDeg,
+                        4,
+                        nullptr,
+                        nullptr,
+                        0,
+                        NormalSpreadFrame::MeanNormal)
+                ->getAdaptiveLeaves()
+                .size(),
+            2u);
+}
+
 TEST(OctreePointCloudNormalVariance, MeanNormalFrameMatchesSensorFrameInOnePlane)
 {
   // Normals tilted within the y-z plane (theta = 0): both frames measure the same
@@ -556,6 +592,32 @@ TEST(OctreePointCloudNormalVariance, MinPointsToSplit)
   ASSERT_EQ(octree->getAdaptiveLeaves().size(), 1u);
   EXPECT_EQ(octree->getAdaptiveLeaves()[0].depth, 0u);
   EXPECT_GT(octree->getAdaptiveLeaves()[0].sigma_theta, kPaperThreshold);
+}
+
+TEST(OctreePointCloudNormalVariance, AVoxelOfExactlyMinPointsSplits)
+{
+  // "A voxel holding fewer points than this is never split": one holding exactly as
+  // many may. The ridge with the minimum at its point count splits the root.
+  const Scene scene = ridge();
+  EXPECT_GT(buildOctree(scene, 0.05, kPaperThreshold, scene.cloud->size())
+                ->getAdaptiveLeaves()
+                .size(),
+            1u);
+  // The smallest case by hand: two points 40 deg apart in normal, the documented
+  // minimum of 2: the root (sigma_theta 20 deg) splits into two leaves of one point,
+  // each without spread.
+  Scene pair;
+  pair.add(Eigen::Vector3f(0.f, 0.f, 1.f), Eigen::Vector3f(0.f, 0.f, -1.f), 1.0);
+  const double t = 40.0 * kDeg;
+  pair.add(Eigen::Vector3f(0.5f, 0.f, 1.f),
+           -Eigen::Vector3d(std::tan(t), 0.0, 1.0).normalized().cast<float>(),
+           1.0);
+  const auto octree = buildOctree(pair, 0.01, kPaperThreshold, 2);
+  ASSERT_EQ(octree->getAdaptiveLeaves().size(), 2u);
+  for (const auto& leaf : octree->getAdaptiveLeaves()) {
+    EXPECT_EQ(leaf.end - leaf.begin, 1u);
+    EXPECT_NEAR(leaf.sigma_theta, 0.0, 1e-6);
+  }
 }
 
 TEST(OctreePointCloudNormalVariance, InvalidPointsSkipped)

@@ -302,6 +302,37 @@ panoramic()
 
 } // namespace
 
+// A point straight behind the sensor has theta = +pi, which is -pi: its quantized
+// angle must be -period / 2 (vertex_angles lie in [-period / 2, period / 2)), the
+// same vertex as a point just left of it. Left at +period / 2, it lay outside the
+// periodic triangulation's range and the whole scan failed to triangulate.
+TEST(PanoramicTriangulation, PointStraightBehindTheSensorIsOnTheSeam)
+{
+  Cloud::Ptr cloud(new Cloud);
+  cloud->push_back({0.f, 0.f, -1.f});    // theta = +pi exactly
+  cloud->push_back({-1e-8f, 0.f, -1.f}); // theta just above -pi: the same cell
+  for (int k = 0; k < 12; ++k)
+    for (const float y : {-0.3f, 0.3f}) {
+      const double t = (k + 0.5) * 2.0 * M_PI / 12.0;
+      cloud->push_back(
+          {static_cast<float>(std::sin(t)), y, static_cast<float>(std::cos(t))});
+    }
+  SphericalDelaunay<pcl::PointXYZ> delaunay;
+  delaunay.setInputCloud(cloud);
+  delaunay.setAngleQuantization(1e-7);
+  delaunay.setProjection(ViewProjection::Panoramic);
+  ASSERT_TRUE(delaunay.triangulate());
+  const auto& t = delaunay.getTriangulation();
+  const std::int32_t period = panoramicPeriod(1e-7);
+  for (const auto& q : t.vertex_angles) {
+    EXPECT_GE(q[0], -period / 2);
+    EXPECT_LT(q[0], period / 2);
+  }
+  ASSERT_GE(t.point_vertex[0], 0);
+  EXPECT_EQ(t.point_vertex[0], t.point_vertex[1]);
+  EXPECT_EQ(t.vertex_angles[t.point_vertex[0]], (QuantizedPoint{-period / 2, 0}));
+}
+
 TEST(PanoramicSegmentation, EveryWallOfARoomIsOneSegmentTheOneBehindTheSeamToo)
 {
   std::vector<int> face;

@@ -733,8 +733,32 @@ TEST(ClassifyTriangles, DegenerateEdgeTriangleIsInvalid)
                     labels,
                     classes);
   ASSERT_EQ(labels.size(), 1u);
-  EXPECT_TRUE(labels[0] == 1u || labels[0] == 2u) << labels[0];
+  // Every label scores alike: the tie goes to the smallest.
+  EXPECT_EQ(labels[0], 1u);
   EXPECT_EQ(classes[0], TriangleClass::InvalidEdge);
+}
+
+TEST(ClassifyTriangles, EquallyCloseLabelsTieOnTheSmallest)
+{
+  // Two segments with bitwise-equal normals (parallel planes) and a triangle 10 deg
+  // from both: the smaller label, whichever corner carries it, and a valid edge.
+  const Vector3fVector label_normals{tilted(0.0), tilted(0.0)};
+  std::vector<std::uint32_t> labels;
+  std::vector<TriangleClass> classes;
+  for (const std::vector<std::uint32_t>& corners :
+       {std::vector<std::uint32_t>{2, 1, 2}, std::vector<std::uint32_t>{1, 2, 2}}) {
+    classifyTriangles({{0, 1, 2}},
+                      {tilted(10.0)},
+                      nullptr,
+                      corners,
+                      label_normals,
+                      kThreshold,
+                      labels,
+                      classes);
+    ASSERT_EQ(labels.size(), 1u);
+    EXPECT_EQ(labels[0], 1u);
+    EXPECT_EQ(classes[0], TriangleClass::ValidEdge);
+  }
 }
 
 int

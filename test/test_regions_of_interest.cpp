@@ -1007,6 +1007,30 @@ TEST_F(CubeRegions, BudgetsAreRespected)
   EXPECT_LE(sr, 0.01);
 }
 
+// A budget is the largest total allowed: one that the best window meets exactly
+// takes it (the points and the solid angle; 0 + x <= x is exact).
+TEST_F(CubeRegions, BudgetsMetExactlyAreEnough)
+{
+  std::vector<RegionOfInterest> all, some;
+  ASSERT_TRUE(computeRegionsOfInterest(*seg_, noBudget(), all));
+  ASSERT_FALSE(all.empty());
+  RegionOfInterestParameters p = noBudget();
+  p.max_points = all[0].estimated_points;
+  RegionOfInterestStats stats;
+  ASSERT_TRUE(computeRegionsOfInterest(*seg_, p, some, &stats));
+  ASSERT_FALSE(some.empty());
+  EXPECT_EQ(some[0].theta_min, all[0].theta_min);
+  EXPECT_EQ(some[0].phi_min, all[0].phi_min);
+  EXPECT_EQ(stats.selected_points, all[0].estimated_points);
+
+  p = noBudget();
+  p.max_solid_angle = all[0].solid_angle;
+  ASSERT_TRUE(computeRegionsOfInterest(*seg_, p, some));
+  ASSERT_FALSE(some.empty());
+  EXPECT_EQ(some[0].theta_min, all[0].theta_min);
+  EXPECT_EQ(some[0].phi_min, all[0].phi_min);
+}
+
 // Whatever the budget, no two selected windows overlap (they may share a border),
 // and the budget's solid angle is the sum of theirs.
 TEST_F(CubeRegions, SelectedWindowsAreDisjoint)

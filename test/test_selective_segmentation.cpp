@@ -385,6 +385,42 @@ pixelGridPlane(const Eigen::Vector3f& n, double noise_k = 0.0, unsigned seed = 1
 
 } // namespace
 
+// A segment's area is the sum of A_v (eq. 6) over its leaves, and every vertex's A_v is
+// the area of its triangles (eq. 3), so over all segments the areas add up to three
+// times the mesh's area when every vertex has a normal. The scene: a 20 deg ridge
+// (z = 3 - tan 10 deg |x - 0.13|) that the octree splits along its fold (more than
+// 7.6 deg of spread) and the merge joins again (20 < 25 deg): segments of many leaves.
+TEST(SelectiveSegmentation, SegmentAreasAreTheSumsOfTheirLeaves)
+{
+  pcl::PointCloud<pcl::PointXYZ>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZ>);
+  const double slope = std::tan(10.0 * M_PI / 180.0);
+  for (int i = 0; i < 60; ++i)
+    for (int j = 0; j < 40; ++j) {
+      const double x = -1.0 + 0.03 * i;
+      cloud->push_back({static_cast<float>(x),
+                        static_cast<float>(-0.6 + 0.03 * j),
+                        static_cast<float>(3.0 - slope * std::abs(x - 0.13))});
+    }
+  SelectiveSegmentation<pcl::PointXYZ> seg;
+  seg.setInputCloud(cloud);
+  std::vector<pcl::PointIndices> clusters;
+  ASSERT_TRUE(seg.extract(clusters));
+  const SegmentationResult& r = seg.getResult();
+  ASSERT_GT(r.leaves.size(), 2 * r.segments.size());
+  std::vector<double> by_label(r.segments.size() + 1, 0.0);
+  for (const auto& leaf : r.leaves)
+    by_label[leaf.label] += leaf.area; // in leaf order, as the segmenter sums
+  double total = 0.0;
+  for (std::size_t s = 0; s < r.segments.size(); ++s) {
+    EXPECT_EQ(r.segments[s].area, by_label[s + 1]) << "segment " << s + 1;
+    total += r.segments[s].area;
+  }
+  ASSERT_EQ(r.counts.without_normal, 0u);
+  const double mesh_area =
+      std::accumulate(r.mesh.areas.begin(), r.mesh.areas.end(), 0.0);
+  EXPECT_NEAR(total, 3.0 * mesh_area, 1e-9 * total);
+}
+
 TEST(SelectiveSegmentation, TiltedPlaneSeenByAPixelGridIsOneSegment)
 {
   // A noise-free plane seen by a 160 x 120 pinhole grid. Float rounding of the points

@@ -242,6 +242,30 @@ TEST(SphericalDelaunay, SharedVertexKeepsNearestPoint)
   EXPECT_EQ(merged.vertex_point[merged.point_vertex[0]], 1);
 }
 
+// Two different points at exactly the same range in one angle cell: the representative
+// is the one with the smaller x (SphericalTriangulation::vertex_point), in either
+// input order. Dyadic coordinates make the squared ranges equal to the last bit; with
+// the tie broken on indices only, the vertex took whichever came first.
+TEST(SphericalDelaunay, EqualRangesTieOnCoordinatesNotOnOrder)
+{
+  const float a = std::ldexp(1.f, -9), b = std::ldexp(1.f, -8);
+  const pcl::PointXYZ p(a, b, 1.f), q(b, a, 1.f);
+  for (const bool p_first : {true, false}) {
+    Cloud::Ptr cloud(new Cloud);
+    cloud->push_back(p_first ? p : q);
+    cloud->push_back(p_first ? q : p);
+    cloud->push_back({0.5f, 0.f, 1.f});
+    cloud->push_back({0.f, 0.5f, 1.f});
+    const SphericalTriangulation result = triangulate(cloud, 0.01);
+    const pcl::index_t p_index = p_first ? 0 : 1;
+    ASSERT_EQ(result.point_vertex[0], result.point_vertex[1]);
+    const pcl::index_t v = result.point_vertex[0];
+    ASSERT_GE(v, 0);
+    EXPECT_EQ(result.vertex_point[v], p_index) << (p_first ? "p first" : "q first");
+    EXPECT_EQ(result.vertex_positions[v], p.getVector3fMap());
+  }
+}
+
 TEST(SphericalDelaunay, SensorPose)
 {
   // Angles on multiples of the step, so that rounding errors of the transform cannot

@@ -120,9 +120,10 @@ seedOrder(const std::vector<pcl::index_t>& vertex_leaf, std::size_t num_leaves);
 /** \brief Label and class of each triangle (eq. 8) from the final vertex labels.
  *
  * Interior: three vertices with one label. Otherwise the triangle takes the label,
- * among its vertices', whose segment normal is closest to its own normal, and is a
- * valid edge when that angle is at most max_edge_triangle_angle and it is not seen
- * edge-on, an invalid edge otherwise.
+ * among its vertices', whose segment normal is closest to its own normal (ties, and
+ * every label of a degenerate triangle: the smallest label), and is a valid edge when
+ * that angle is at most max_edge_triangle_angle and it is not seen edge-on, an
+ * invalid edge otherwise.
  *
  * \param[in] triangles \#T triangles over vertex ids
  * \param[in] triangle_normals \#T unit normals (NaN: degenerate, never a valid edge)
