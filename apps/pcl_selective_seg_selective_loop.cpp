@@ -691,16 +691,6 @@ runScene(const Options& opt,
   return true;
 }
 
-/** Where -h or --help stands as an option (not as another option's value). */
-bool
-helpAsked(int argc, char** argv)
-{
-  for (int i = 1; i < argc; i += 2)
-    if (std::string(argv[i]) == "-h" || std::string(argv[i]) == "--help")
-      return true;
-  return false;
-}
-
 /** Every file a run writes for \a scenes under \a folder. */
 std::vector<std::string>
 outputFiles(const std::string& folder, const std::vector<std::string>& scenes)
@@ -728,7 +718,7 @@ run(int argc, char** argv)
     print_error("Give -out FOLDER.\n");
     return kUsageError;
   }
-  if (helpAsked(argc, argv)) {
+  if (selseg_apps::helpAsked(argc, argv)) {
     printHelp(argv[0]);
     return 0;
   }

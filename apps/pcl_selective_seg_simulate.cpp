@@ -281,20 +281,10 @@ saveCloud(const std::string& path, const pcl::PointCloud<pcl::PointXYZL>& cloud)
   return true;
 }
 
-/** Where -h or --help stands as an option (not as another option's value). */
-bool
-helpAsked(int argc, char** argv)
-{
-  for (int i = 1; i < argc; i += 2)
-    if (std::string(argv[i]) == "-h" || std::string(argv[i]) == "--help")
-      return true;
-  return false;
-}
-
 int
 run(int argc, char** argv)
 {
-  if (helpAsked(argc, argv)) {
+  if (selseg_apps::helpAsked(argc, argv)) {
     printHelp(argv[0]);
     return 0;
   }

@@ -114,6 +114,15 @@ choiceName(ViewProjection value)
 }
 
 bool
+helpAsked(int argc, char** argv)
+{
+  for (int i = 1; i < argc; i += 2)
+    if (std::string(argv[i]) == "-h" || std::string(argv[i]) == "--help")
+      return true;
+  return false;
+}
+
+bool
 optionsGivenOnce(int argc,
                  char** argv,
                  const std::function<bool(const std::string&)>& takes_value)

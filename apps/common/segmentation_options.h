@@ -38,6 +38,10 @@ parseNumber(int argc, char** argv, const char* flag, T& value)
   return true;
 }
 
+/** \brief Whether -h or --help stands as an option, for a tool whose every option
+ * takes one value: at an odd position, not as another option's value (-o -h). */
+bool helpAsked(int argc, char** argv);
+
 /** \brief False, after printing an error, when an option is given more than once:
  * pcl::console's parsers use its first value and ignore the others. Arguments that
  * start with '-' and a letter are options; \a takes_value(option) tells whether the
