@@ -70,6 +70,15 @@ function(contents var folder)
   list(SORT names)
   set(${var} "${names}" PARENT_SCOPE)
 endfunction()
+# expectFullUnchanged(): WORK/full holds only what the test put there, cube.dat unchanged
+macro(expectFullUnchanged)
+  contents(left ${WORK}/full)
+  file(READ ${WORK}/full/cube.dat cube_dat)
+  if(NOT left STREQUAL "chair.dat;cube.dat" OR NOT cube_dat STREQUAL "old\n")
+    set(failures "${failures}\n  a failed run changed its folder: '${left}', cube.dat "
+      "'${cube_dat}'")
+  endif()
+endmacro()
 # Failed runs leave the output folder as it was: no partial outputs, no temporaries, old
 # files unchanged. Every file is staged and put in place at the end of the run; here
 # the door fails after the cube's files were all staged: with -coarse_factor 1 its
@@ -82,21 +91,11 @@ file(WRITE ${WORK}/full/cube.dat "old\n")
 expect(1 "coarse scan's [0-9]+ points exceed the point budget"
   -out ${WORK}/full -scenes cube,door -iterations 1 -coarse_factor 1
   -budget_fraction 1)
-contents(left ${WORK}/full)
-file(READ ${WORK}/full/cube.dat cube_dat)
-if(NOT left STREQUAL "chair.dat;cube.dat" OR NOT cube_dat STREQUAL "old\n")
-  set(failures "${failures}\n  a failed run changed its folder: '${left}', cube.dat "
-    "'${cube_dat}'")
-endif()
+expectFullUnchanged()
 # An output that cannot be written (chair.dat is a folder) is refused before any scan.
 expect(1 "cannot write '.*chair.dat': it is a folder"
   -out ${WORK}/full -scenes cube,chair -iterations 1)
-contents(left ${WORK}/full)
-file(READ ${WORK}/full/cube.dat cube_dat)
-if(NOT left STREQUAL "chair.dat;cube.dat" OR NOT cube_dat STREQUAL "old\n")
-  set(failures "${failures}\n  a failed run changed its folder: '${left}', cube.dat "
-    "'${cube_dat}'")
-endif()
+expectFullUnchanged()
 # Every output is checked before the scans: a folder in table.md's place (found only
 # after the whole run before).
 file(MAKE_DIRECTORY ${WORK}/probe/table.md)
