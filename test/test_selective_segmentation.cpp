@@ -337,6 +337,42 @@ TEST(SelectiveSegmentation, LabelsMeshAndOctreeAgree)
   }
 }
 
+// Labels rank segments by size; segments of one size keep the order in which they grew,
+// which is the order of their seeds: a segment grows from its first leaf in the seed
+// order (most vertices first, ties by leaf index), so the rank comes from the result's
+// leaves alone. The cube scene's many small edge segments share sizes.
+TEST(SelectiveSegmentation, SegmentsOfOneSizeAreRankedInTheOrderTheyGrew)
+{
+  const auto cloud = cubeScene(20000, 3);
+  SelectiveSegmentation<pcl::PointXYZL> seg;
+  std::vector<pcl::PointIndices> clusters;
+  ASSERT_TRUE(segment<pcl::PointXYZL>(cloud, seg, clusters));
+  const auto& r = seg.getResult();
+  std::vector<std::size_t> seeds(r.leaves.size());
+  std::iota(seeds.begin(), seeds.end(), 0);
+  std::stable_sort(seeds.begin(), seeds.end(), [&](std::size_t a, std::size_t b) {
+    return r.leaves[a].num_points > r.leaves[b].num_points;
+  });
+  // grown[label - 1]: the turn of the segment's first seed.
+  std::vector<std::size_t> grown(r.segments.size(), seeds.size());
+  for (std::size_t turn = 0; turn < seeds.size(); ++turn) {
+    const std::uint32_t label = r.leaves[seeds[turn]].label;
+    ASSERT_GE(label, 1u);
+    ASSERT_LE(label, r.segments.size());
+    grown[label - 1] = std::min(grown[label - 1], turn);
+  }
+  std::size_t ties = 0;
+  for (std::size_t s = 1; s < r.segments.size(); ++s) {
+    ASSERT_LT(grown[s], seeds.size()) << "label " << s + 1 << " has no leaf";
+    ASSERT_GE(r.segments[s - 1].num_points, r.segments[s].num_points);
+    if (r.segments[s - 1].num_points == r.segments[s].num_points) {
+      ++ties;
+      EXPECT_LT(grown[s - 1], grown[s]) << "labels " << s << " and " << s + 1;
+    }
+  }
+  EXPECT_GT(ties, 10u); // the rule is exercised
+}
+
 TEST(SelectiveSegmentation, WallFacingTheSensorIsOneSegment)
 {
   const auto cloud = wall(60, 40); // organized 60 x 40: every cell co-circular

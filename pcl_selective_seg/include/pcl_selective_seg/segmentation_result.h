@@ -74,7 +74,9 @@ struct OctreeLeaf {
 
 /** \brief A segment of the result. */
 struct Segment {
-  std::uint32_t label = 0;    ///< label >= 1; labels are ranked by size, largest first
+  /** label >= 1; labels are ranked by size (num_points), largest first; segments of one
+   * size in the order they grew (the order of their first leaves in seedOrder()). */
+  std::uint32_t label = 0;
   std::size_t num_points = 0; ///< input points with this label
   Eigen::Vector3f normal = Eigen::Vector3f::Zero(); ///< N_S (eq. 7), toward the sensor
   /** N_S in the sensor frame, as the merge computed it (normal is it turned to the
