@@ -381,6 +381,48 @@ tableRow(const std::string& scene,
   return line;
 }
 
+/** The files a run writes for each scene: DIR/<scene><suffix>. runScene() names its
+ * outputs through sceneFile() and the early check goes through the whole list, so an
+ * output cannot be written without being checked first. */
+enum SceneFile {
+  kDensePcd,
+  kCoarsePcd,
+  kCoarseRoisJson,
+  kRefinedPcd,
+  kWindowsJson,
+  kBoundaryErrorsDat,
+  kMinVoxelTxt,
+  kDat,
+  kNumSceneFiles
+};
+constexpr const char* kSceneFileSuffix[kNumSceneFiles] = {"_dense.pcd",
+                                                          "_coarse.pcd",
+                                                          "_coarse_rois.json",
+                                                          "_refined.pcd",
+                                                          "_windows.json",
+                                                          "_boundary_errors.dat",
+                                                          "_min_voxel.txt",
+                                                          ".dat"};
+
+/** DIR/<scene><suffix of \a file>. */
+std::string
+sceneFile(const std::string& folder, const std::string& scene, SceneFile file)
+{
+  return folder + "/" + scene + kSceneFileSuffix[file];
+}
+
+/** Every file a run writes for \a scenes under \a folder. */
+std::vector<std::string>
+outputFiles(const std::string& folder, const std::vector<std::string>& scenes)
+{
+  std::vector<std::string> files;
+  for (const auto& scene : scenes)
+    for (int f = 0; f < kNumSceneFiles; ++f)
+      files.push_back(sceneFile(folder, scene, static_cast<SceneFile>(f)));
+  files.push_back(folder + "/table.md");
+  return files;
+}
+
 /** Writes \a cloud to \a outputs' temporary file for \a path. */
 bool
 savePcd(selseg_apps::OutputTransaction& outputs,
@@ -428,7 +470,7 @@ runScene(const Options& opt,
   if (opt.seed >= 0.0)
     setup.sensor.seed = static_cast<std::uint32_t>(opt.seed);
   const double fine = fineStep(name) * opt.step_scale;
-  const std::string base = opt.out + "/" + name;
+  const auto file = [&](SceneFile f) { return sceneFile(opt.out, name, f); };
 
   sim::ReferenceBoundary reference;
   if (!sim::makeReferenceBoundary(setup, 0.5 * fine, reference)) {
@@ -456,7 +498,7 @@ runScene(const Options& opt,
       return false;
     }
     uniform.push_back(s);
-    if (f == 1.0 && !savePcd(outputs, base + "_dense.pcd", cloud))
+    if (f == 1.0 && !savePcd(outputs, file(kDensePcd), cloud))
       return false;
   }
   const std::size_t dense_points = uniform.back().points;
@@ -525,19 +567,18 @@ runScene(const Options& opt,
                  r.iteration,
                  100.0 * static_cast<double>(on_edge) / static_cast<double>(estimated));
     if (r.iteration == 0) {
-      files_ok =
-          files_ok && savePcd(outputs, base + "_coarse.pcd", *r.cloud) &&
-          selseg_apps::writeRegionsJson(outputs.stage(base + "_coarse_rois.json"),
-                                        name,
-                                        r.region_parameters,
-                                        stats,
-                                        regions);
+      files_ok = files_ok && savePcd(outputs, file(kCoarsePcd), *r.cloud) &&
+                 selseg_apps::writeRegionsJson(outputs.stage(file(kCoarseRoisJson)),
+                                               name,
+                                               r.region_parameters,
+                                               stats,
+                                               regions);
     }
     scanned.insert(scanned.end(), regions.begin(), regions.end());
     if (!regions.empty())
       last_parameters = r.region_parameters;
     if (regions.empty() || r.iteration == opt.iterations)
-      files_ok = files_ok && savePcd(outputs, base + "_refined.pcd", *r.cloud);
+      files_ok = files_ok && savePcd(outputs, file(kRefinedPcd), *r.cloud);
     print_info("%s: round %d, %zu points, boundary accuracy %s mm; evidence "
                "%zu/%zu/%zu vertices (transition/small/sparse), %zu candidate windows, "
                "%zu already fine, %zu over budget, %zu chosen (%zu points estimated)\n",
@@ -639,10 +680,10 @@ runScene(const Options& opt,
   whole.target_step = loop.fine_step;
   files_ok =
       files_ok && selseg_apps::writeRegionsJson(
-                      outputs.stage(base + "_windows.json"), name, whole, all, scanned);
+                      outputs.stage(file(kWindowsJson)), name, whole, all, scanned);
   // Where the error is: every reference boundary point with its distance to the
   // nearest predicted boundary, for the finest uniform scan and the last round.
-  std::ofstream errors(outputs.stage(base + "_boundary_errors.dat"));
+  std::ofstream errors(outputs.stage(file(kBoundaryErrorsDat)));
   errors << "# theta phi (rad) distance_dense distance_selective (m) depth_jump "
             "crease_angle (deg, nan: undetermined) in_window (0/1)\n";
   for (std::size_t i = 0; i < reference.points.size(); ++i) {
@@ -656,9 +697,9 @@ runScene(const Options& opt,
   }
   errors.close();
   files_ok = files_ok && static_cast<bool>(errors);
-  std::ofstream voxel(outputs.stage(base + "_min_voxel.txt"));
+  std::ofstream voxel(outputs.stage(file(kMinVoxelTxt)));
   voxel << std::setprecision(9) << min_voxel << "\n";
-  std::ofstream dat(outputs.stage(base + ".dat"));
+  std::ofstream dat(outputs.stage(file(kDat)));
   dat << "# " << name << ": fine step " << fine << " rad, coarse factor "
       << opt.coarse_factor << ", budget " << loop.point_budget << " points\n"
       << "# points seconds accuracy_mean_m accuracy_p90_m spurious_mean_m correct "
@@ -689,25 +730,6 @@ runScene(const Options& opt,
                       rounds[i],
                       dense_points);
   return true;
-}
-
-/** Every file a run writes for \a scenes under \a folder. */
-std::vector<std::string>
-outputFiles(const std::string& folder, const std::vector<std::string>& scenes)
-{
-  std::vector<std::string> files;
-  for (const auto& scene : scenes)
-    for (const char* suffix : {"_dense.pcd",
-                               "_coarse.pcd",
-                               "_coarse_rois.json",
-                               "_refined.pcd",
-                               "_windows.json",
-                               "_boundary_errors.dat",
-                               "_min_voxel.txt",
-                               ".dat"})
-      files.push_back(folder + "/" + scene + suffix);
-  files.push_back(folder + "/table.md");
-  return files;
 }
 
 int
