@@ -250,6 +250,8 @@ methods()
   SelectiveSegmentationParameters not_edge_on = defaults;
   not_edge_on.point_normal_triangles =
       pcl::selective_seg::PointNormalTriangles::NotEdgeOn;
+  SelectiveSegmentationParameters grown = defaults;
+  grown.merge_with = pcl::selective_seg::MergeWith::Segments;
   const auto selective = [](const SelectiveSegmentationParameters& p) {
     return [p](const Cloud::ConstPtr& c) { return runSelective(c, p); };
   };
@@ -258,6 +260,7 @@ methods()
           {"selective (eq. 5 in the voxel's frame)", selective(mean_frame)},
           {"selective (eq. 7 weighted by area)", selective(area_weight)},
           {"selective (eq. 2 without edge-on triangles)", selective(not_edge_on)},
+          {"selective (eq. 9-10 with grown segments)", selective(grown)},
           {"selective (rings 3)", selective(rings3)},
           {"selective (rings 2, vertex-mean eq. 8)", selective(robust2)},
           {"selective (rings 3, vertex-mean eq. 8)", selective(robust3)},

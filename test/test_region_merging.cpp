@@ -313,6 +313,46 @@ TEST(MergeSeedSegments, OrderDecidesTheChain)
   EXPECT_NEAR(angleDeg(m.segment_normals[1], tilted(0.0)), 0.0, 1e-3);
 }
 
+// A segment that has grown meets a later one at a valid edge triangle of the later one
+// (eq. 8), with the two normals within 25 degrees (eq. 9). Strip A A A C B B, leaf
+// normals A = 0, C = 20, B = 40 degrees, A_v = 1, 0.01, 1; triangles A|C at 26 and C|B
+// at 35 degrees. A (6 vertices) grows first: A|C is 26 degrees from N_A, invalid, so
+// A stays alone. B grows next: C|B is 5 degrees from N_B, valid, and C (20 degrees from
+// B) joins: N_BC = n(40) / 1 + n(20) / 0.01 = (34.8448, 0, -94.7353), 20.194 degrees.
+// Now A|C is 5.8 degrees from N_BC, valid, and A, 20.194 degrees from it, is a
+// neighbouring segment within 25 degrees: MergeWith::Segments absorbs it, N =
+// (34.8448, 0, -95.7353), 20.000 degrees; MergeWith::Seeds (the default) leaves it.
+TEST(MergeSeedSegments, GrowingSegmentAbsorbsAGrownOneWhenAsked)
+{
+  Strip strip({0, 0, 0, 1, 2, 2}, {0.0, 20.0, 40.0}, {1.0, 0.01, 1.0});
+  strip.setJoinNormal(2, tilted(26.0));
+  strip.setJoinNormal(3, tilted(35.0));
+  Merged seeds = merge(strip.input());
+  EXPECT_EQ(seeds.leaf_segment, (Segments{0, 1, 1}));
+  ASSERT_EQ(seeds.segment_normals.size(), 2u);
+  EXPECT_NEAR(angleDeg(seeds.segment_normals[1], tilted(20.194138)), 0.0, 1e-3);
+
+  for (const int threads : {1, 3}) {
+    MergeInput in = strip.input(threads);
+    in.merge_with = pcl::selective_seg::MergeWith::Segments;
+    const Merged m = merge(in);
+    EXPECT_EQ(m.leaf_segment, (Segments{0, 0, 0}));
+    ASSERT_EQ(m.segment_normals.size(), 1u);
+    EXPECT_NEAR(angleDeg(m.segment_normals[0], tilted(20.0)), 0.0, 1e-3);
+  }
+
+  // A at -6 degrees: 26.19 degrees from N_BC, beyond eq. 9's 25: not absorbed.
+  Strip apart({0, 0, 0, 1, 2, 2}, {-6.0, 20.0, 40.0}, {1.0, 0.01, 1.0});
+  apart.setJoinNormal(2, tilted(26.0));
+  apart.setJoinNormal(3, tilted(35.0));
+  MergeInput in = apart.input();
+  in.merge_with = pcl::selective_seg::MergeWith::Segments;
+  const Merged m = merge(in);
+  EXPECT_EQ(m.leaf_segment, (Segments{0, 1, 1}));
+  ASSERT_EQ(m.segment_normals.size(), 2u);
+  EXPECT_NEAR(angleDeg(m.segment_normals[1], tilted(20.194138)), 0.0, 1e-3);
+}
+
 TEST(MergeSeedSegments, SegmentNormalIsInverseAreaWeightedMean)
 {
   // eq. 7: seeds at 0 degrees (A_v = 1) and 20 degrees (A_v = 4).

@@ -162,6 +162,32 @@ TEST(SelectiveSegmentation, ShuffledInputGivesIdenticalSegments)
   EXPECT_EQ(a.getResult().leaves.size(), b.getResult().leaves.size());
 }
 
+// MergeWith::Segments: the same segments for any point order and thread count, and
+// fewer than with the default, which leaves grown segments as they are.
+TEST(SelectiveSegmentation, MergingGrownSegmentsIsOrderAndThreadInvariant)
+{
+  const auto cloud = cubeScene(20000, 7);
+  std::vector<int> perm;
+  const auto shuffled = shuffledCopy(*cloud, 42, perm);
+  SelectiveSegmentation<pcl::PointXYZL> seeds, a, b;
+  auto p = a.getParameters();
+  p.merge_with = pcl::selective_seg::MergeWith::Segments;
+  p.num_threads = 1;
+  a.setParameters(p);
+  p.num_threads = 3;
+  b.setParameters(p);
+  std::vector<pcl::PointIndices> cs, ca, cb;
+  ASSERT_TRUE(segment<pcl::PointXYZL>(cloud, seeds, cs));
+  ASSERT_TRUE(segment<pcl::PointXYZL>(cloud, a, ca));
+  ASSERT_TRUE(segment<pcl::PointXYZL>(shuffled, b, cb));
+  ASSERT_EQ(ca.size(), cb.size());
+  EXPECT_LT(ca.size(), cs.size());
+  for (std::size_t k = 0; k < perm.size(); ++k)
+    ASSERT_EQ(a.getResult().labels[perm[k]], b.getResult().labels[k]) << k;
+  for (std::size_t s = 0; s < ca.size(); ++s)
+    EXPECT_EQ(a.getResult().segments[s].normal, b.getResult().segments[s].normal) << s;
+}
+
 TEST(SelectiveSegmentation, AutomaticThreadsFollowOpenMP)
 {
 #ifdef _OPENMP

@@ -277,6 +277,7 @@ TEST_F(Tool, SummaryRecordsEveryParameter)
   // A summary says how it was made: every segmentation option, given or default.
   ASSERT_EQ(run("'" + scan + "' -ignore_viewpoint -json " + out("summary.json") +
                 " -spread_frame mean_normal -segment_weight area -normal_rings 2"
+                " -merge_with segments"
                 " -normal_triangles not_edge_on -edge_normal vertex_mean"
                 " -voxel_factor 3 -max_depth 12 -angle_step_rad 2e-7"),
             0);
@@ -285,6 +286,7 @@ TEST_F(Tool, SummaryRecordsEveryParameter)
                             "\"incidence_deg\": 85",
                             "\"spread_frame\": \"mean_normal\"",
                             "\"segment_weight\": \"area\"",
+                            "\"merge_with\": \"segments\"",
                             "\"normal_rings\": 2",
                             "\"normal_triangles\": \"not_edge_on\"",
                             "\"edge_normal\": \"vertex_mean\"",

@@ -310,6 +310,29 @@ TEST(SelectiveSegmentationUpdate, ChangedMergeParametersReplayNoSegment)
   }
 }
 
+// With MergeWith::Segments a grown segment can still be absorbed by a later one: none
+// is taken over, before or after the option changes, and the result is still
+// extract()'s on the union.
+TEST(SelectiveSegmentationUpdate, MergingGrownSegmentsReplaysNoSegment)
+{
+  const auto coarse = toXYZ(*selseg_test::cubeScan(5000, 11));
+  using pcl::selective_seg::MergeWith;
+  for (const auto [before, after] :
+       {std::pair{MergeWith::Segments, MergeWith::Segments},
+        std::pair{MergeWith::Seeds, MergeWith::Segments},
+        std::pair{MergeWith::Segments, MergeWith::Seeds}}) {
+    SCOPED_TRACE(static_cast<int>(before) * 10 + static_cast<int>(after));
+    Seg seg;
+    auto first = seg.getParameters();
+    first.merge_with = before;
+    auto then = first;
+    then.merge_with = after;
+    ASSERT_NO_FATAL_FAILURE(updateWithInteriorWindow(coarse, first, then, seg));
+    EXPECT_GT(seg.getUpdateStatistics().kept_leaves, 0u);
+    EXPECT_EQ(seg.getUpdateStatistics().replayed_segments, 0u);
+  }
+}
+
 TEST(SelectiveSegmentationUpdate, RepeatedUpdatesAndAnyOrderOfTheNewPoints)
 {
   auto scan = toXYZ(*selseg_test::cubeScan(8000, 21));

@@ -682,6 +682,7 @@ writeSummaryJson(const std::string& path,
       << ", \"incidence_deg\": " << p.max_view_incidence_angle * deg
       << ", \"spread_frame\": " << jsonString(choiceName(p.normal_spread_frame))
       << ", \"segment_weight\": " << jsonString(choiceName(p.segment_normal_weight))
+      << ", \"merge_with\": " << jsonString(choiceName(p.merge_with))
       << ", \"normal_rings\": " << p.normal_rings
       << ", \"normal_triangles\": " << jsonString(choiceName(p.point_normal_triangles))
       << ", \"edge_normal\": " << jsonString(choiceName(p.edge_triangle_normal))

@@ -16,6 +16,7 @@ using pcl::console::print_error;
 using pcl::console::print_info;
 using pcl::selective_seg::DelaunayBackend;
 using pcl::selective_seg::EdgeTriangleNormal;
+using pcl::selective_seg::MergeWith;
 using pcl::selective_seg::NormalSpreadFrame;
 using pcl::selective_seg::PointNormalTriangles;
 using pcl::selective_seg::SegmentNormalWeight;
@@ -41,6 +42,8 @@ template <typename Enum> using Choices = std::vector<std::pair<std::string, Enum
 const Choices<SegmentNormalWeight> kSegmentWeights = {
     {"inverse_area", SegmentNormalWeight::InverseArea},
     {"area", SegmentNormalWeight::Area}};
+const Choices<MergeWith> kMergeWith = {{"seeds", MergeWith::Seeds},
+                                       {"segments", MergeWith::Segments}};
 const Choices<NormalSpreadFrame> kSpreadFrames = {
     {"sensor", NormalSpreadFrame::Sensor},
     {"mean_normal", NormalSpreadFrame::MeanNormal}};
@@ -87,6 +90,12 @@ std::string
 choiceName(SegmentNormalWeight value)
 {
   return nameIn(kSegmentWeights, value);
+}
+
+std::string
+choiceName(MergeWith value)
+{
+  return nameIn(kMergeWith, value);
 }
 
 std::string
@@ -151,6 +160,7 @@ segmentationFlags()
                                                  "-spread_frame",
                                                  "-merge_deg",
                                                  "-segment_weight",
+                                                 "-merge_with",
                                                  "-edge_deg",
                                                  "-incidence_deg",
                                                  "-normal_rings",
@@ -183,6 +193,9 @@ printSegmentationHelp()
              d.max_merge_angle / kDeg);
   print_info("  -segment_weight NAME   weight of a leaf normal in its segment's (eq. 7): "
              "inverse_area (paper) or area (default inverse_area)\n");
+  print_info("  -merge_with NAME       what a growing segment merges with (eq. 9-10): "
+             "seeds (not yet in a segment) or segments (also those grown before it; "
+             "one thread) (default seeds)\n");
   print_info("  -edge_deg X            max angle between a valid edge triangle and the "
              "segment [deg] (default %g)\n",
              d.max_edge_triangle_angle / kDeg);
@@ -259,6 +272,7 @@ parseSegmentationOptions(int argc, char** argv, SelectiveSegmentationParameters&
       !parseNumber(argc, argv, "-threads", p.num_threads) ||
       !parseChoice(
           argc, argv, "-segment_weight", kSegmentWeights, p.segment_normal_weight) ||
+      !parseChoice(argc, argv, "-merge_with", kMergeWith, p.merge_with) ||
       !parseChoice(argc, argv, "-spread_frame", kSpreadFrames, p.normal_spread_frame) ||
       !parseChoice(argc,
                    argv,

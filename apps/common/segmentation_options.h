@@ -69,8 +69,10 @@ const std::vector<std::string>& segmentationFlags();
 void printSegmentationHelp();
 
 /** \brief The command-line name of an enum option's value (as -segment_weight,
- * -spread_frame, -normal_triangles, -edge_normal and -projection take it). */
+ * -merge_with, -spread_frame, -normal_triangles, -edge_normal and -projection take it).
+ */
 std::string choiceName(pcl::selective_seg::SegmentNormalWeight value);
+std::string choiceName(pcl::selective_seg::MergeWith value);
 std::string choiceName(pcl::selective_seg::NormalSpreadFrame value);
 std::string choiceName(pcl::selective_seg::PointNormalTriangles value);
 std::string choiceName(pcl::selective_seg::EdgeTriangleNormal value);

@@ -89,6 +89,11 @@ SelectiveSegmentationParameters::validate(std::string* why) const
                   "segment_normal_weight",
                   static_cast<int>(segment_normal_weight),
                   "inverse_area or area (SegmentNormalWeight 0 or 1)");
+  if (merge_with != MergeWith::Seeds && merge_with != MergeWith::Segments)
+    return reject(why,
+                  "merge_with",
+                  static_cast<int>(merge_with),
+                  "seeds or segments (MergeWith 0 or 1)");
   if (point_normal_triangles != PointNormalTriangles::All &&
       point_normal_triangles != PointNormalTriangles::NotEdgeOn)
     return reject(why,

@@ -109,9 +109,40 @@ struct GrowingSegment {
       else
         sum += leaf_normal.cast<double>() / leaf_area;
     }
+    renormalize();
+  }
+
+  /** Absorb another segment's eq. 7 sum (MergeWith::Segments). */
+  void addSum(const Eigen::Vector3d& other)
+  {
+    sum += other;
+    renormalize();
+  }
+
+private:
+  void renormalize()
+  {
     const double norm = sum.norm();
     if (norm > 0.0 && std::isfinite(norm))
       normal = sum / norm;
+  }
+};
+
+/** The segments grown so far, for MergeWith::Segments: a growing segment may absorb
+ * them. A union-find over segment ids: an absorbed segment's leaves keep its id, whose
+ * root is the segment that absorbed it. */
+struct GrownSegments {
+  std::vector<pcl::index_t> parent;     ///< the root of each segment is its own parent
+  std::vector<Eigen::Vector3d> sums;    ///< eq. 7 sum of each segment as it grew
+  std::vector<Eigen::Vector3d> normals; ///< its normalized sum
+
+  pcl::index_t find(pcl::index_t s)
+  {
+    while (parent[s] != s) {
+      parent[s] = parent[parent[s]]; // path halving
+      s = parent[s];
+    }
+    return s;
   }
 };
 
@@ -183,10 +214,24 @@ struct LeafTriangles {
 /** Which segment holds each leaf, as the sequential growth sees it. */
 struct SharedState {
   std::vector<pcl::index_t>& leaf_segment;
-  pcl::index_t k; ///< the growing segment
+  pcl::index_t k;                 ///< the growing segment
+  GrownSegments* grown = nullptr; ///< MergeWith::Segments: the segments grown before
 
   bool claimed(pcl::index_t l) const { return leaf_segment[l] >= 0; }
-  bool own(pcl::index_t l) const { return leaf_segment[l] == k; }
+  bool own(pcl::index_t l) const
+  {
+    const pcl::index_t s = leaf_segment[l];
+    return s == k || (grown && s >= 0 && grown->find(s) == k);
+  }
+  /** The grown segment (a root) holding \a l, when it may be absorbed; -1 otherwise. */
+  pcl::index_t absorbable(pcl::index_t l) const
+  {
+    const pcl::index_t s = leaf_segment[l];
+    if (!grown || s < 0 || s == k)
+      return -1;
+    const pcl::index_t root = grown->find(s);
+    return root == k ? -1 : root;
+  }
   /** A held leaf met (nothing to note here). */
   void metHeld(pcl::index_t) const {}
   /** Whether a leaf is held, as a segment taken over needs (SegmentReplay). */
@@ -210,6 +255,8 @@ struct OverlayState {
 
   bool claimed(pcl::index_t l) const { return leaf_segment[l] >= 0 || overlay[l] != 0; }
   bool own(pcl::index_t l) const { return overlay[l] == k; }
+  /** Growth ahead of its turn never absorbs (MergeWith::Segments runs in turn). */
+  pcl::index_t absorbable(pcl::index_t) const { return -1; }
   /** A held leaf met: noted when another segment of this window holds it (a leaf held
    * in the shared state stays held: nothing to check). */
   void metHeld(pcl::index_t l)
@@ -262,11 +309,14 @@ public:
         visitTriangle(adjacency_.entries[i], segment, state);
       }
     }
+    sum_ = segment.sum;
     return segment.normal;
   }
 
   /** The leaves the last grow() claimed, in the order it claimed them. */
   const std::vector<pcl::index_t>& queue() const { return queue_; }
+  /** The eq. 7 sum of the segment the last grow() made. */
+  const Eigen::Vector3d& sum() const { return sum_; }
 
 private:
   template <typename State>
@@ -283,7 +333,11 @@ private:
       if (other < 0)
         continue;
       if (state.claimed(other)) {
-        state.metHeld(other);
+        const pcl::index_t j = state.absorbable(other);
+        if (j >= 0)
+          absorb(j, segment, state);
+        else
+          state.metHeld(other);
         continue;
       }
       const Eigen::Vector3f& n_other = leafNormal(in_, other);
@@ -294,6 +348,21 @@ private:
       queue_.push_back(other);
     }
   }
+
+  /** Eq. 9-10 between the growing segment and the grown segment \a j
+   * (MergeWith::Segments): when their normals are close enough, \a j's leaves become
+   * the growing segment's and its sum joins eq. 7's. They are not searched again: \a j
+   * searched them when it grew, and each leaf's triangles are then visited once per
+   * growth (linear, however often a segment is absorbed). */
+  void absorb(pcl::index_t j, GrowingSegment& segment, SharedState& state)
+  {
+    GrownSegments& grown = *state.grown;
+    if (grown.normals[j].dot(segment.normal) < cos_merge_)
+      return;
+    grown.parent[j] = state.k;
+    segment.addSum(grown.sums[j]);
+  }
+  template <typename State> void absorb(pcl::index_t, GrowingSegment&, State&) {}
 
   /** Eq. 8 for a triangle that is not edge-on. */
   bool isValidFor(pcl::index_t t, const Eigen::Vector3d& segment_normal) const
@@ -307,6 +376,7 @@ private:
   const MergeInput& in_;
   const LeafTriangles& adjacency_;
   std::vector<pcl::index_t> queue_;
+  Eigen::Vector3d sum_ = Eigen::Vector3d::Zero();
   double cos_merge_;
   double cos_edge_;
 };
@@ -469,6 +539,10 @@ public:
         normal = growth.grow(seed, state);
       segment_normals.push_back(normal.cast<float>());
     };
+    if (in_.merge_with == MergeWith::Segments) {
+      growAbsorbing(order, growth, leaf_segment, segment_normals);
+      return;
+    }
     if (parts < 2 || num_leaves < kMinParallelLeaves) {
       for (const auto seed : order)
         if (leaf_segment[seed] < 0)
@@ -548,6 +622,36 @@ private:
    * come first and often grow the largest segments: in short windows, these are
    * committed before the threads grow the seeds around them. */
   static constexpr std::size_t kFirstWindow = 8;
+
+  /** MergeWith::Segments: the seeds in order on one thread, each growing segment
+   * absorbing the grown ones it meets (SegmentGrowth::absorb()); then the segments
+   * left are numbered in the order they were created. */
+  static void growAbsorbing(const std::vector<pcl::index_t>& order,
+                            SegmentGrowth& growth,
+                            std::vector<pcl::index_t>& leaf_segment,
+                            Vector3fVector& segment_normals)
+  {
+    GrownSegments grown;
+    for (const auto seed : order) {
+      if (leaf_segment[seed] >= 0)
+        continue;
+      const auto k = static_cast<pcl::index_t>(grown.parent.size());
+      grown.parent.push_back(k);
+      SharedState state{leaf_segment, k, &grown};
+      const Eigen::Vector3d normal = growth.grow(seed, state);
+      grown.sums.push_back(growth.sum());
+      grown.normals.push_back(normal);
+    }
+    std::vector<pcl::index_t> number(grown.parent.size(), -1);
+    for (std::size_t k = 0; k < grown.parent.size(); ++k)
+      if (grown.find(static_cast<pcl::index_t>(k)) == static_cast<pcl::index_t>(k)) {
+        number[k] = static_cast<pcl::index_t>(segment_normals.size());
+        segment_normals.push_back(grown.normals[k].cast<float>());
+      }
+    for (auto& s : leaf_segment)
+      if (s >= 0)
+        s = number[static_cast<std::size_t>(grown.find(s))];
+  }
 
   /** Grow the seeds order[w, w_end) that lie in [first, last), in order. */
   void speculate(const std::vector<pcl::index_t>& order,

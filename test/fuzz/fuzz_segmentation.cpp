@@ -314,6 +314,7 @@ LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size)
         static_cast<pcl::selective_seg::DelaunayBackend>(slot[12] & 0xff);
     p.projection =
         static_cast<pcl::selective_seg::ViewProjection>((slot[12] >> 8) & 0xff);
+    p.merge_with = static_cast<pcl::selective_seg::MergeWith>((slot[12] >> 16) & 0xff);
   } else {
     p.edge_triangle_normal =
         static_cast<pcl::selective_seg::EdgeTriangleNormal>(slot[11] & 1);
@@ -323,6 +324,7 @@ LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size)
         static_cast<pcl::selective_seg::SegmentNormalWeight>((slot[11] >> 2) & 1);
     p.point_normal_triangles =
         static_cast<pcl::selective_seg::PointNormalTriangles>((slot[11] >> 3) & 1);
+    p.merge_with = static_cast<pcl::selective_seg::MergeWith>((slot[11] >> 4) & 1);
     if (slot[12] & 1)
       p.delaunay_backend = pcl::selective_seg::DelaunayBackend::BoostVoronoi;
     // Bit 3: the panoramic projection (with the spread frame it requires).

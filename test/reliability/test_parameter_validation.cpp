@@ -19,6 +19,7 @@
 
 using pcl::selective_seg::DelaunayBackend;
 using pcl::selective_seg::EdgeTriangleNormal;
+using pcl::selective_seg::MergeWith;
 using pcl::selective_seg::NormalSpreadFrame;
 using pcl::selective_seg::PointNormalTriangles;
 using pcl::selective_seg::SegmentNormalWeight;
@@ -109,6 +110,13 @@ fields()
        [](Params& p, double v) {
          p.segment_normal_weight =
              static_cast<SegmentNormalWeight>(static_cast<int>(v));
+       },
+       {2, 7, 255},
+       {0, 1}},
+      {"merge_with",
+       "seeds or segments",
+       [](Params& p, double v) {
+         p.merge_with = static_cast<MergeWith>(static_cast<int>(v));
        },
        {2, 7, 255},
        {0, 1}},

@@ -66,6 +66,21 @@ enum class SegmentNormalWeight : std::uint8_t {
   Area = 1
 };
 
+/** \brief Which segments a growing segment merges with (eq. 9-10). */
+enum class MergeWith : std::uint8_t {
+  /** Seeds (leaves) not yet in a segment: a segment that has grown is final, and a
+   * later segment that meets it across a valid edge triangle stops there. Each leaf
+   * joins once. */
+  Seeds = 0,
+  /** Also the segments grown before it: a grown segment met at a vertex of a valid
+   * edge triangle (eq. 8), whose normal is within max_merge_angle of the growing
+   * segment's (eq. 9), is absorbed (eq. 10): its eq. 7 sum is added to the growing
+   * segment's and its leaves become the growing segment's (not searched again: they
+   * were when it grew). Runs the merge on one thread and without update()'s take-over
+   * of unchanged segments (docs/pipeline.md, "Which segments merge"). */
+  Segments = 1
+};
+
 /** \brief Which of a point's triangles eq. 2 sums into its normal. */
 enum class PointNormalTriangles : std::uint8_t {
   /** Every triangle at the point, as in the paper. */
@@ -114,6 +129,9 @@ struct PCL_EXPORTS SelectiveSegmentationParameters {
   /** \brief Weight of a leaf's normal in its segment's normal (eq. 7). Default:
    * 1 / A_v, as in the paper (docs/parameters.md). */
   SegmentNormalWeight segment_normal_weight = SegmentNormalWeight::InverseArea;
+  /** \brief Which segments a growing segment merges with (eq. 9-10). Default: the
+   * seeds not yet in a segment (docs/pipeline.md, "Which segments merge"). */
+  MergeWith merge_with = MergeWith::Seeds;
 
   /** \brief Maximum angle between an edge triangle's normal and the growing segment's
    * normal for the triangle to be searched for neighbours (eq. 8) [rad]. Paper: 25
@@ -153,7 +171,8 @@ struct PCL_EXPORTS SelectiveSegmentationParameters {
    * (used when min_voxel_size is 0). Valid: [0.5, 1000]. */
   double min_voxel_size_factor = 2.0;
 
-  /** \brief A voxel holding fewer points than this is never split. Valid: >= 2. */
+  /** \brief A voxel holding fewer mesh vertices (distinct directions: points on one
+   * quantized direction count once) than this is never split. Valid: >= 2. */
   int min_points_to_split = 8;
 
   /** \brief Deepest octree level; bounds the tree for clouds of extreme extent, where

@@ -70,6 +70,9 @@ struct MergeInput {
   /** Weight of a leaf's normal in eq. 7: 1 / A_v (the paper) or A_v. */
   SegmentNormalWeight segment_normal_weight = SegmentNormalWeight::InverseArea;
   double max_edge_triangle_angle = 0.0; ///< eq. 8 threshold [rad]
+  /** Which segments a growing segment merges with: the free seeds only (Seeds), or
+   * also the segments grown before it (Segments: one thread, no replay). */
+  MergeWith merge_with = MergeWith::Seeds;
   /** Threads for building the incidence lists and for growing seeds ahead of their
    * turn (0: defaultThreads()). The result does not depend on it. */
   int num_threads = 1;
@@ -89,6 +92,12 @@ struct MergeInput {
  * N_Sk is the normalized sum of N_v / A_v (N_v A_v with segment_normal_weight = Area)
  * over its seeds (eq. 7), updated at every join. Each seed joins once and each triangle
  * is examined at most once per leaf of its vertices: linear in the mesh size.
+ *
+ * With merge_with = MergeWith::Segments, a segment grown before S_k that holds a vertex
+ * of such a valid edge triangle is absorbed when its normal is within max_merge_angle
+ * of N_Sk: its leaves join S_k and its eq. 7 sum is added to S_k's (its leaves are not
+ * searched again: they were when it grew, which keeps the merge linear). The segments
+ * left keep their creation order. One thread, and no replay.
  *
  * With several threads and at least 1,024 leaves, the threads grow seeds ahead of
  * their turn, each over its own part of the leaves, and a segment so grown is kept

@@ -23,11 +23,14 @@ namespace selective_seg {
 enum class TriangleClass : std::uint8_t {
   /** All three vertices in one segment (T_I). */
   Interior = 0,
-  /** Vertices in several segments, normal within max_edge_triangle_angle of the normal
-   * of one of them (T_VE): the surface continues across it. */
+  /** Not interior (vertices in several segments, or a vertex without a label), normal
+   * within max_edge_triangle_angle of the normal of one of its vertices' segments, and
+   * not seen edge-on (max_view_incidence_angle) (T_VE): the surface continues across
+   * it. */
   ValidEdge = 1,
-  /** Vertices in several segments, normal far from all of them (T_IE): the triangle
-   * spans a transition region (an edge, a depth jump). */
+  /** Not interior, and normal far from all its vertices' segments, or seen edge-on, or
+   * degenerate, or without any labeled vertex (T_IE): the triangle spans a transition
+   * region (an edge, a depth jump). */
   InvalidEdge = 2
 };
 

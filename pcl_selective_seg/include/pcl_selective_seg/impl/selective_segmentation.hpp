@@ -515,6 +515,7 @@ SelectiveSegmentation<PointT>::mergeAndLabel()
   in.max_merge_angle = params_.max_merge_angle;
   in.segment_normal_weight = params_.segment_normal_weight;
   in.max_edge_triangle_angle = params_.max_edge_triangle_angle;
+  in.merge_with = params_.merge_with;
   in.num_threads = numThreads();
   MergeReplay replay;
   std::vector<pcl::index_t> replay_leaf_segment, replay_seed;
@@ -601,7 +602,10 @@ SelectiveSegmentation<PointT>::prepareReplay(
   // A vertex-mean edge normal would change with a neighbour's vertex normal.
   const PreviousMerge& previous = previous_merge_;
   const SelectiveSegmentationParameters& was = previous.params;
+  // With MergeWith::Segments a segment can change after it has grown: none is taken
+  // over.
   if (octree_->getNumKeptLeaves() == 0 || previous.leaf_segment.empty() ||
+      params_.merge_with != MergeWith::Seeds || was.merge_with != MergeWith::Seeds ||
       params_.edge_triangle_normal != EdgeTriangleNormal::Facet ||
       was.edge_triangle_normal != EdgeTriangleNormal::Facet ||
       was.max_merge_angle != params_.max_merge_angle ||
