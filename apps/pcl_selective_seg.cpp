@@ -24,6 +24,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <new>
 #include <string>
 #include <vector>
 
@@ -492,5 +493,13 @@ main(int argc, char** argv)
   Options opt;
   if (const int rc = parseOptions(argc, argv, opt))
     return rc;
-  return segment(opt);
+  // Out of memory outside the library's own handling (reading, the outputs): a
+  // message, and the outputs' temporaries removed on the way out of segment().
+  try {
+    return segment(opt);
+  } catch (const std::bad_alloc&) {
+    print_error("Out of memory: segment a smaller scan (crop or downsample it) or "
+                "give the process more memory.\n");
+    return kRuntimeError;
+  }
 }

@@ -32,6 +32,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <new>
 #include <string>
 #include <vector>
 
@@ -460,9 +461,14 @@ main(int argc, char** argv)
   }
   std::string table = kHeader;
   std::fputs(kHeader, stdout);
-  for (const auto& input : opt.inputs)
-    if (!evaluate(input, table))
-      return kRuntimeError;
+  try {
+    for (const auto& input : opt.inputs)
+      if (!evaluate(input, table))
+        return kRuntimeError;
+  } catch (const std::bad_alloc&) {
+    print_error("Out of memory: compare smaller clouds (crop or downsample them).\n");
+    return kRuntimeError;
+  }
   if (!opt.output.empty() && !writeTable(opt.output, table))
     return kRuntimeError;
   return 0;

@@ -45,6 +45,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <limits>
+#include <new>
 #include <string>
 #include <utility>
 #include <vector>
@@ -943,8 +944,13 @@ main(int argc, char** argv)
     return kRuntimeError;
   }
   Scene scene;
-  if (!loadInput(opt, scene) || !checkDisplay() || !segment(opt, scene))
+  try {
+    if (!loadInput(opt, scene) || !checkDisplay() || !segment(opt, scene))
+      return kRuntimeError;
+  } catch (const std::bad_alloc&) {
+    print_error("Out of memory: view a smaller scan (crop or downsample it).\n");
     return kRuntimeError;
+  }
   const bool offscreen = !opt.screenshot.empty();
   SegmentationViewer viewer(scene, opt, offscreen);
   if (offscreen)

@@ -194,7 +194,11 @@ public:
    * \param[out] clusters the segments' point indices, largest first (segment i has
    *             label i + 1)
    * \return false, with a PCL_ERROR saying why and empty outputs, on a missing or
-   *         unusable input or an invalid parameter. */
+   *         unusable input or an invalid parameter, and when memory runs out in a
+   *         sequential part of the pipeline (std::bad_alloc is caught; the result is
+   *         cleared). Memory running out inside a parallel stage ends the process
+   *         (std::terminate: an exception cannot leave an OpenMP region;
+   *         docs/reliability.md, "Out of memory"). */
   bool extract(std::vector<pcl::PointIndices>& clusters);
 
   /** \brief Fold more points of the same scene, seen from the same sensor pose, into
@@ -213,8 +217,9 @@ public:
    * \param[in] new_points the points to add
    * \param[out] clusters as extract(), over the union
    * \return as extract(); false also when there is no result to update. On failure
-   *         the input cloud and indices are those before the call; the result is
-   *         kept when nothing ran (invalid parameters), cleared when a stage failed. */
+   *         the input cloud and indices are those before the call, and so are the
+   *         parameters; the result is kept when nothing ran (invalid parameters),
+   *         cleared when a stage failed or memory ran out. */
   bool update(const PointCloud& new_points, std::vector<pcl::PointIndices>& clusters);
 
   /** \brief What the last update() changed. */
@@ -331,6 +336,16 @@ protected:
 
   /** \brief Fail: report, clear the outputs, keep the point counts. */
   bool fail(const char* stage, const std::string& why);
+  /** \brief Fail after std::bad_alloc: report, clear the outputs and what update()
+   * would fold into. */
+  bool failOutOfMemory(const char* stage);
+  /** \brief extract() but for its handling of std::bad_alloc. */
+  bool runExtract(std::vector<pcl::PointIndices>& clusters);
+  /** \brief update() from the union of the input and \a new_points on, but for its
+   * handling of std::bad_alloc and its restoring of the parameters and input. */
+  bool updateUnion(const PointCloud& new_points,
+                   bool in_place,
+                   std::vector<pcl::PointIndices>& clusters);
 
   /** \brief The triangle normals eq. 2 sums: triangle_normals_, or with
    * PointNormalTriangles::NotEdgeOn a copy in \a masked without the edge-on ones

@@ -196,6 +196,11 @@ public:
   const SphericalTriangulation& getTriangulation() const { return triangulation_; }
 
 protected:
+  /** \brief After initCompute(): false, with a PCL_ERROR, when the indices standing
+   * for the whole cloud are fewer than its points (PCLBase::initCompute() goes on
+   * with the old ones when it cannot allocate them). */
+  bool wholeCloudIndices();
+
   std::string getClassName() const override { return "SphericalDelaunay"; }
 
   void performReconstruction(pcl::PolygonMesh& output) override;

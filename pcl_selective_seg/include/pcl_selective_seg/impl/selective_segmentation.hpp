@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <new>
 #include <numeric>
 
 #ifdef _OPENMP
@@ -38,6 +39,10 @@ SelectiveSegmentation<PointT>::initCompute()
   }
   if (!pcl::PCLBase<PointT>::initCompute())
     return false;
+  // PCLBase::initCompute() reports a failed allocation of the indices that stand for
+  // the whole cloud but goes on with the old ones (fewer points than the cloud's).
+  if (this->fake_indices_ && indices_->size() != input_->size())
+    throw std::bad_alloc();
   std::string why;
   if (!params_.validate(&why)) {
     PCL_ERROR(
@@ -58,6 +63,25 @@ SelectiveSegmentation<PointT>::fail(const char* stage, const std::string& why)
   result_.counts = counts;
   octree_.reset();
   normals_.reset();
+  this->deinitCompute();
+  return false;
+}
+
+template <typename PointT>
+bool
+SelectiveSegmentation<PointT>::failOutOfMemory(const char* stage)
+{
+  const std::size_t points = input_ ? input_->size() : 0;
+  clearOutputs();
+  previous_leaves_ = typename Octree::PreviousLeaves();
+  previous_merge_ = PreviousMerge();
+  mesh_input_.reset();
+  PCL_ERROR("[pcl::selective_seg::%s::%s] out of memory with %zu input points: "
+            "segment fewer (setIndices(), a voxel grid filter) or give the process "
+            "more memory\n",
+            getClassName().c_str(),
+            stage,
+            points);
   this->deinitCompute();
   return false;
 }
@@ -640,6 +664,18 @@ SelectiveSegmentation<PointT>::prepareReplay(
 template <typename PointT>
 bool
 SelectiveSegmentation<PointT>::extract(std::vector<pcl::PointIndices>& clusters)
+{
+  try {
+    return runExtract(clusters);
+  } catch (const std::bad_alloc&) {
+    std::vector<pcl::PointIndices>().swap(clusters);
+    return failOutOfMemory("extract");
+  }
+}
+
+template <typename PointT>
+bool
+SelectiveSegmentation<PointT>::runExtract(std::vector<pcl::PointIndices>& clusters)
 {
   clusters.clear();
   clearOutputs();

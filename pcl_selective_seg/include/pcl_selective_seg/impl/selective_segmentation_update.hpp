@@ -38,6 +38,29 @@ SelectiveSegmentation<PointT>::update(const PointCloud& new_points,
   const bool in_place = meshInputUnchanged();
   const auto previous_input = input_;
   const auto previous_indices = this->fake_indices_ ? IndicesPtr() : indices_;
+  const SelectiveSegmentationParameters saved = params_;
+  bool ok = false;
+  try {
+    ok = updateUnion(new_points, in_place, clusters);
+  } catch (const std::bad_alloc&) {
+    std::vector<pcl::PointIndices>().swap(clusters);
+    ok = failOutOfMemory("update");
+  }
+  params_ = saved;
+  if (!ok) { // the input and indices before the call
+    this->setInputCloud(previous_input);
+    if (previous_indices)
+      this->setIndices(previous_indices);
+  }
+  return ok;
+}
+
+template <typename PointT>
+bool
+SelectiveSegmentation<PointT>::updateUnion(const PointCloud& new_points,
+                                           bool in_place,
+                                           std::vector<pcl::PointIndices>& clusters)
+{
   pcl::StopWatch total;
   update_stats_ = UpdateStatistics();
   update_stats_.new_points = new_points.size();
@@ -63,7 +86,6 @@ SelectiveSegmentation<PointT>::update(const PointCloud& new_points,
     this->setInputCloud(merged);
 
   // The finest voxel of the result being updated is kept (see the header).
-  const SelectiveSegmentationParameters saved = params_;
   if (!(params_.min_voxel_size > 0.0))
     params_.min_voxel_size = result_.min_voxel_size;
   bool ok = false;
@@ -73,12 +95,6 @@ SelectiveSegmentation<PointT>::update(const PointCloud& new_points,
     result_.timings.total = total.getTimeSeconds();
   } else if (!failed) {
     ok = extract(clusters); // no triangulation to update: from scratch on the union
-  }
-  params_ = saved;
-  if (!ok) { // the input and indices before the call
-    this->setInputCloud(previous_input);
-    if (previous_indices)
-      this->setIndices(previous_indices);
   }
   return ok;
 }

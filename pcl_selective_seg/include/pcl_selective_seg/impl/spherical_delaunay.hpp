@@ -96,6 +96,20 @@ SphericalDelaunay<PointT>::getSensorPose() const
 
 template <typename PointT>
 bool
+SphericalDelaunay<PointT>::wholeCloudIndices()
+{
+  if (!this->fake_indices_ || this->indices_->size() == this->input_->size())
+    return true;
+  PCL_ERROR("[pcl::selective_seg::%s::triangulate] out of memory for the indices of "
+            "%zu points\n",
+            getClassName().c_str(),
+            this->input_->size());
+  this->deinitCompute();
+  return false;
+}
+
+template <typename PointT>
+bool
 SphericalDelaunay<PointT>::sensorPoseIsRigid(std::string* why) const
 {
   if (!has_sensor_pose_ && this->input_) {
@@ -372,6 +386,8 @@ SphericalDelaunay<PointT>::triangulate()
     return false;
   }
   if (!this->initCompute())
+    return false;
+  if (!wholeCloudIndices())
     return false;
   const auto n = static_cast<pcl::index_t>(this->input_->size());
   const bool bad_index = std::any_of(this->indices_->begin(),

@@ -35,7 +35,7 @@ SphericalDelaunay<PointT>::insertPoints(std::size_t first_new_point,
       tri.projection != ViewProjection::Forward ||
       projection_ != ViewProjection::Forward)
     return false;
-  if (!this->initCompute())
+  if (!this->initCompute() || !wholeCloudIndices())
     return false;
   const auto& cloud = *this->input_;
   const auto& indices = *this->indices_;
