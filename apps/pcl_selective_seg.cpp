@@ -24,7 +24,6 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
-#include <new>
 #include <string>
 #include <vector>
 
@@ -495,11 +494,8 @@ main(int argc, char** argv)
     return rc;
   // Out of memory outside the library's own handling (reading, the outputs): a
   // message, and the outputs' temporaries removed on the way out of segment().
-  try {
-    return segment(opt);
-  } catch (const std::bad_alloc&) {
-    print_error("Out of memory: segment a smaller scan (crop or downsample it) or "
-                "give the process more memory.\n");
-    return kRuntimeError;
-  }
+  return selseg_apps::runReportingOutOfMemory(
+      [&] { return segment(opt); },
+      "segment a smaller scan (crop or downsample it) or give the process more memory.",
+      kRuntimeError);
 }

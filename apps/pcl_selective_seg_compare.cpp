@@ -32,11 +32,11 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
-#include <new>
 #include <string>
 #include <vector>
 
 #include "outputs.h"
+#include "process_memory.h"
 #include "scan_io.h"
 #include "segmentation_options.h"
 
@@ -461,14 +461,16 @@ main(int argc, char** argv)
   }
   std::string table = kHeader;
   std::fputs(kHeader, stdout);
-  try {
-    for (const auto& input : opt.inputs)
-      if (!evaluate(input, table))
-        return kRuntimeError;
-  } catch (const std::bad_alloc&) {
-    print_error("Out of memory: compare smaller clouds (crop or downsample them).\n");
-    return kRuntimeError;
-  }
+  if (const int code = selseg_apps::runReportingOutOfMemory(
+          [&] {
+            for (const auto& input : opt.inputs)
+              if (!evaluate(input, table))
+                return kRuntimeError;
+            return 0;
+          },
+          "compare smaller clouds (crop or downsample them).",
+          kRuntimeError))
+    return code;
   if (!opt.output.empty() && !writeTable(opt.output, table))
     return kRuntimeError;
   return 0;

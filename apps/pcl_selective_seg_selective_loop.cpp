@@ -29,13 +29,13 @@
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
-#include <new>
 #include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "outputs.h"
+#include "process_memory.h"
 #include "roi_json.h"
 #include "roi_options.h"
 #include "segmentation_options.h"
@@ -823,10 +823,8 @@ main(int argc, char** argv)
 {
   // Out of memory (a small -step_scale on a small machine): a message, and the
   // temporaries and the folders the run made are removed on the way out of run().
-  try {
-    return run(argc, argv);
-  } catch (const std::bad_alloc&) {
-    print_error("Out of memory: use a larger -step_scale or fewer -scenes.\n");
-    return kRuntimeError;
-  }
+  return selseg_apps::runReportingOutOfMemory(
+      [&] { return run(argc, argv); },
+      "use a larger -step_scale or fewer -scenes.",
+      kRuntimeError);
 }

@@ -24,11 +24,11 @@
 #include <cstdio>
 #include <iterator>
 #include <map>
-#include <new>
 #include <set>
 #include <string>
 
 #include "outputs.h"
+#include "process_memory.h"
 #include "segmentation_options.h"
 
 using namespace pcl::console;
@@ -329,10 +329,6 @@ run(int argc, char** argv)
 int
 main(int argc, char** argv)
 {
-  try {
-    return run(argc, argv);
-  } catch (const std::bad_alloc&) {
-    print_error("Out of memory: use a smaller -density.\n");
-    return kRuntimeError;
-  }
+  return selseg_apps::runReportingOutOfMemory(
+      [&] { return run(argc, argv); }, "use a smaller -density.", kRuntimeError);
 }

@@ -45,12 +45,12 @@
 #include <cstdlib>
 #include <fstream>
 #include <limits>
-#include <new>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "outputs.h"
+#include "process_memory.h"
 #include "roi_json.h"
 #include "roi_options.h"
 #include "scan_io.h"
@@ -944,13 +944,15 @@ main(int argc, char** argv)
     return kRuntimeError;
   }
   Scene scene;
-  try {
-    if (!loadInput(opt, scene) || !checkDisplay() || !segment(opt, scene))
-      return kRuntimeError;
-  } catch (const std::bad_alloc&) {
-    print_error("Out of memory: view a smaller scan (crop or downsample it).\n");
-    return kRuntimeError;
-  }
+  if (const int code = selseg_apps::runReportingOutOfMemory(
+          [&] {
+            return loadInput(opt, scene) && checkDisplay() && segment(opt, scene)
+                       ? 0
+                       : kRuntimeError;
+          },
+          "view a smaller scan (crop or downsample it).",
+          kRuntimeError))
+    return code;
   const bool offscreen = !opt.screenshot.empty();
   SegmentationViewer viewer(scene, opt, offscreen);
   if (offscreen)

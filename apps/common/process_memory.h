@@ -6,7 +6,10 @@
 
 #pragma once
 
+#include <pcl/console/print.h>
+
 #include <array>
+#include <new>
 
 namespace selseg_apps {
 
@@ -37,5 +40,21 @@ inline constexpr std::array<const char*, 5> kMallocOptionVariables = {
  *         glibc's malloc options (GLIBC_TUNABLES with glibc.malloc.*, or one of
  *         kMallocOptionVariables): the user's choice wins. */
 bool keepFreedMemory();
+
+/** \brief Run \a work and return its exit code; when memory runs out in it beyond
+ * what the library reports itself (std::bad_alloc out of \a work, whose stack unwinds
+ * first, so that the outputs' temporaries are removed), print "Out of memory: " and
+ * \a advice and return \a out_of_memory_code. */
+template <typename Work>
+int
+runReportingOutOfMemory(Work&& work, const char* advice, int out_of_memory_code)
+{
+  try {
+    return work();
+  } catch (const std::bad_alloc&) {
+    pcl::console::print_error("Out of memory: %s\n", advice);
+    return out_of_memory_code;
+  }
+}
 
 } // namespace selseg_apps
