@@ -9,6 +9,7 @@
  * repairs and classifies them, then the canonical fans. See docs/delaunay.md. */
 
 #include <pcl_selective_seg/delaunay_2d.h>
+#include <pcl_selective_seg/impl/parallel_exceptions.hpp>
 
 #include <algorithm>
 #include <array>
@@ -740,6 +741,7 @@ SweepTriangulation::repairAndClassify()
       static_cast<std::size_t>(num_triangles) >= detail::kMinParallelItems;
   const int threads = parallel ? num_threads_ : 1;
   std::vector<std::vector<index_t>> found(static_cast<std::size_t>(threads));
+  detail::ParallelExceptions errors;
 #ifdef _OPENMP
 #pragma omp parallel num_threads(threads)
 #endif
@@ -755,9 +757,10 @@ SweepTriangulation::repairAndClassify()
         continue;
       for (index_t e = 4 * t; e < 4 * t + 3; ++e)
         if (twins_[e] > e && circle_[e] == kUntested && classify(e) > 0)
-          mine.push_back(e);
+          errors.run([&] { mine.push_back(e); });
     }
   }
+  errors.rethrow();
   for (const auto& part : found)
     illegal.insert(illegal.end(), part.begin(), part.end());
   while (!illegal.empty() && !overBudget()) {
@@ -1104,17 +1107,21 @@ triangulateSortedInSlabs(const std::vector<QuantizedPoint>& points,
                                            1,
                                            triangles.data() + slabs[s].base));
   }
+  detail::ParallelExceptions errors;
 #ifdef _OPENMP
 #pragma omp parallel for num_threads(num_slabs) schedule(static, 1)
 #endif
   for (int s = 0; s < num_slabs; ++s)
-    triangulateSlab(points,
-                    slabs[s],
-                    std::move(meshes[s]),
-                    s > 0,
-                    s + 1 < num_slabs,
-                    triangles,
-                    neighbours);
+    errors.run([&] {
+      triangulateSlab(points,
+                      slabs[s],
+                      std::move(meshes[s]),
+                      s > 0,
+                      s + 1 < num_slabs,
+                      triangles,
+                      neighbours);
+    });
+  errors.rethrow();
   std::vector<index_t> local;
   std::vector<SeamEdge> seam;
   for (Slab& slab : slabs) {

@@ -4,6 +4,7 @@
  *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
  */
 
+#include <pcl_selective_seg/impl/parallel_exceptions.hpp>
 #include <pcl_selective_seg/mesh_normals.h>
 #include <pcl_selective_seg/region_merging.h>
 #include <pcl_selective_seg/spherical_delaunay.h>
@@ -361,25 +362,28 @@ recomputeOverStars(std::vector<std::pair<pcl::index_t, pcl::index_t>>& seeds,
   }
   const auto num_seeds = static_cast<std::ptrdiff_t>(seeds.size());
   std::vector<std::uint8_t> partial(incidence ? seeds.size() : 0, 0);
+  detail::ParallelExceptions errors;
 #pragma omp parallel num_threads(num_threads)
   {
     std::vector<pcl::index_t> star;
 #pragma omp for schedule(static)
-    for (std::ptrdiff_t k = 0; k < num_seeds; ++k) {
-      const pcl::index_t v = seeds[k].first;
-      starOf(v, seeds[k].second, triangles, neighbours, star);
-      if (incidence && static_cast<std::size_t>((*incidence)[v]) != star.size()) {
-        partial[k] = 1;
-        continue;
-      }
-      vertexNormal(star.data(),
-                   star.data() + star.size(),
-                   normals,
-                   areas,
-                   vertex_normals[v],
-                   vertex_areas[v]);
-    }
+    for (std::ptrdiff_t k = 0; k < num_seeds; ++k)
+      errors.run([&] {
+        const pcl::index_t v = seeds[k].first;
+        starOf(v, seeds[k].second, triangles, neighbours, star);
+        if (incidence && static_cast<std::size_t>((*incidence)[v]) != star.size()) {
+          partial[k] = 1;
+          return;
+        }
+        vertexNormal(star.data(),
+                     star.data() + star.size(),
+                     normals,
+                     areas,
+                     vertex_normals[v],
+                     vertex_areas[v]);
+      });
   }
+  errors.rethrow();
   if (std::find(partial.begin(), partial.end(), 1) == partial.end())
     return;
   // The vertices the walk did not get around, over their triangles from the mesh.
@@ -445,32 +449,35 @@ scatterVertexNormals(std::size_t num_vertices,
   std::vector<pcl::index_t> corners(runs > 1 ? num_vertices : 0, 0);
   pcl::index_t* const direct = runs > 1 ? corners.data() : nullptr;
   std::vector<char> out_of_order(runs, 0);
+  detail::ParallelExceptions errors;
 #pragma omp parallel for num_threads(static_cast<int>(runs)) schedule(static, 1)
-  for (std::ptrdiff_t c = 0; c < static_cast<std::ptrdiff_t>(runs); ++c) {
-    const pcl::index_t upper = run_lowest[c + 1];
-    for (std::size_t t = c * num_triangles / runs; t < (c + 1) * num_triangles / runs;
-         ++t) {
-      if (c > 0 && lowestVertex(triangles[t]) < run_lowest[c]) {
-        out_of_order[c] = 1;
-        break;
-      }
-      const bool finite_area = std::isfinite(areas[t]);
-      const double weight = normalWeight(areas[t], normals[t]);
-      const Eigen::Vector3d term = weight * normals[t].cast<double>();
-      for (const auto v : triangles[t]) {
-        if (v >= upper) {
-          deferred[c].emplace_back(v, static_cast<pcl::index_t>(t));
-          continue;
+  for (std::ptrdiff_t c = 0; c < static_cast<std::ptrdiff_t>(runs); ++c)
+    errors.run([&] {
+      const pcl::index_t upper = run_lowest[c + 1];
+      for (std::size_t t = c * num_triangles / runs; t < (c + 1) * num_triangles / runs;
+           ++t) {
+        if (c > 0 && lowestVertex(triangles[t]) < run_lowest[c]) {
+          out_of_order[c] = 1;
+          return;
         }
-        if (finite_area)
-          vertex_areas[v] += areas[t];
-        if (weight > 0.0)
-          sums[v] += term;
-        if (direct)
-          ++direct[v];
+        const bool finite_area = std::isfinite(areas[t]);
+        const double weight = normalWeight(areas[t], normals[t]);
+        const Eigen::Vector3d term = weight * normals[t].cast<double>();
+        for (const auto v : triangles[t]) {
+          if (v >= upper) {
+            deferred[c].emplace_back(v, static_cast<pcl::index_t>(t));
+            continue;
+          }
+          if (finite_area)
+            vertex_areas[v] += areas[t];
+          if (weight > 0.0)
+            sums[v] += term;
+          if (direct)
+            ++direct[v];
+        }
       }
-    }
-  }
+    });
+  errors.rethrow();
   if (std::find(out_of_order.begin(), out_of_order.end(), 1) != out_of_order.end())
     return false;
   vertex_normals.resize(num_vertices);
@@ -893,7 +900,8 @@ medianEdgeLength(const Vector3fVector& positions,
     below += histograms[bucket++];
   // The bucket's values, in any order (the value of a rank does not depend on it).
   std::vector<double> candidates;
-  candidates.reserve(histograms[bucket]);
+  candidates.reserve(histograms[bucket]); // the insertions below do not allocate
+  detail::ParallelExceptions errors;
 #ifdef _OPENMP
 #pragma omp parallel num_threads(num_parts) if (parallel)
 #endif
@@ -904,12 +912,13 @@ medianEdgeLength(const Vector3fVector& positions,
 #endif
     for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(num_squares); ++k)
       if (bucketOf(squares[k]) == bucket)
-        mine.push_back(squares[k]);
+        errors.run([&] { mine.push_back(squares[k]); });
 #ifdef _OPENMP
 #pragma omp critical(selseg_median_candidates)
 #endif
     candidates.insert(candidates.end(), mine.begin(), mine.end());
   }
+  errors.rethrow();
   const auto middle = candidates.begin() + static_cast<std::ptrdiff_t>(rank - below);
   std::nth_element(candidates.begin(), middle, candidates.end());
   return std::sqrt(*middle);

@@ -4,6 +4,7 @@
  *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
  */
 
+#include <pcl_selective_seg/impl/parallel_exceptions.hpp>
 #include <pcl_selective_seg/region_merging.h>
 #include <pcl_selective_seg/spherical_delaunay.h>
 
@@ -561,11 +562,15 @@ public:
     std::size_t window = kFirstWindow;
     for (std::size_t w = 0; w < order.size();) {
       const std::size_t w_end = std::min(order.size(), w + window);
+      detail::ParallelExceptions errors;
 #ifdef _OPENMP
 #pragma omp parallel for num_threads(static_cast<int>(parts)) schedule(static, 1)
 #endif
       for (std::ptrdiff_t p = 0; p < static_cast<std::ptrdiff_t>(parts); ++p)
-        speculate(order, w, w_end, bounds[p], bounds[p + 1], leaf_segment, ahead[p]);
+        errors.run([&] {
+          speculate(order, w, w_end, bounds[p], bounds[p + 1], leaf_segment, ahead[p]);
+        });
+      errors.rethrow();
       std::vector<std::size_t> next(parts, 0); // each part's next grown segment
       for (std::size_t i = w; i < w_end; ++i) {
         const pcl::index_t seed = order[i];

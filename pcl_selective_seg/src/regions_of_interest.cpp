@@ -4,6 +4,7 @@
  *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
  */
 
+#include <pcl_selective_seg/impl/parallel_exceptions.hpp>
 #include <pcl_selective_seg/regions_of_interest.h>
 
 #include <pcl/console/print.h>
@@ -12,6 +13,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <new>
 #include <numeric>
 #include <sstream>
 #include <tuple>
@@ -236,30 +238,34 @@ vertexSpacing(const SphericalTriangulation& tri,
         .norm();
   };
   const auto count = static_cast<std::ptrdiff_t>(nv);
-  std::vector<double> lengths;
+  std::vector<double> lengths; // empty: each thread's copy allocates nothing
+  detail::ParallelExceptions errors;
 #ifdef _OPENMP
 #pragma omp parallel for num_threads(threads) schedule(static)                         \
     firstprivate(lengths) if (count >= kParallelFrom)
 #endif
-  for (std::ptrdiff_t iv = 0; iv < count; ++iv) {
-    const auto v = static_cast<std::size_t>(iv);
-    lengths.clear();
-    for (std::uint32_t i = start[v]; i < start[v + 1]; ++i) {
-      if (i > start[v] && at[i] == at[i - 1])
-        continue;
-      const auto& t = tri.triangles[at[i]];
-      for (int k = 0; k < 3; ++k)
-        if (static_cast<std::size_t>(t[k]) == v) {
-          lengths.push_back(length(t[k], t[(k + 1) % 3]));
-          lengths.push_back(length(t[(k + 2) % 3], t[k]));
-        }
-    }
-    if (lengths.empty())
-      continue;
-    const auto mid = lengths.begin() + static_cast<std::ptrdiff_t>(lengths.size() / 2);
-    std::nth_element(lengths.begin(), mid, lengths.end());
-    spacing[v] = *mid;
-  }
+  for (std::ptrdiff_t iv = 0; iv < count; ++iv)
+    errors.run([&] {
+      const auto v = static_cast<std::size_t>(iv);
+      lengths.clear();
+      for (std::uint32_t i = start[v]; i < start[v + 1]; ++i) {
+        if (i > start[v] && at[i] == at[i - 1])
+          continue;
+        const auto& t = tri.triangles[at[i]];
+        for (int k = 0; k < 3; ++k)
+          if (static_cast<std::size_t>(t[k]) == v) {
+            lengths.push_back(length(t[k], t[(k + 1) % 3]));
+            lengths.push_back(length(t[(k + 2) % 3], t[k]));
+          }
+      }
+      if (lengths.empty())
+        return;
+      const auto mid =
+          lengths.begin() + static_cast<std::ptrdiff_t>(lengths.size() / 2);
+      std::nth_element(lengths.begin(), mid, lengths.end());
+      spacing[v] = *mid;
+    });
+  errors.rethrow();
   return spacing;
 }
 
@@ -1198,13 +1204,16 @@ windowSolidAngle(double theta_min,
   return corner(u1, v1) - corner(u0, v1) - corner(u1, v0) + corner(u0, v0);
 }
 
+namespace {
+
+/** computeRegionsOfInterest() but for its handling of std::bad_alloc. */
 bool
-computeRegionsOfInterest(const SegmentationResult& result,
-                         const SphericalTriangulation& tri,
-                         const Eigen::Affine3f& sensor_to_cloud,
-                         const RegionOfInterestParameters& p,
-                         std::vector<RegionOfInterest>& regions,
-                         RegionOfInterestStats* stats)
+regionsOfInterest(const SegmentationResult& result,
+                  const SphericalTriangulation& tri,
+                  const Eigen::Affine3f& sensor_to_cloud,
+                  const RegionOfInterestParameters& p,
+                  std::vector<RegionOfInterest>& regions,
+                  RegionOfInterestStats* stats)
 {
   regions.clear();
   RegionOfInterestStats local;
@@ -1476,11 +1485,13 @@ computeRegionsOfInterest(const SegmentationResult& result,
     std::vector<RegionOfInterest> first(windows.size());
     std::vector<Fate> fates(windows.size());
     const auto count = static_cast<std::ptrdiff_t>(windows.size());
+    detail::ParallelExceptions errors;
 #ifdef _OPENMP
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 1) if (count >= 64)
 #endif
     for (std::ptrdiff_t i = 0; i < count; ++i)
-      fates[i] = evaluate(windows[i], first[i]);
+      errors.run([&] { fates[i] = evaluate(windows[i], first[i]); });
+    errors.rethrow();
     for (std::size_t i = 0; i < windows.size(); ++i)
       take(std::move(windows[i]),
            first[i],
@@ -1543,6 +1554,30 @@ computeRegionsOfInterest(const SegmentationResult& result,
     regions.push_back(pool[i].region);
   st.selected = regions.size();
   return true;
+}
+
+} // namespace
+
+bool
+computeRegionsOfInterest(const SegmentationResult& result,
+                         const SphericalTriangulation& tri,
+                         const Eigen::Affine3f& sensor_to_cloud,
+                         const RegionOfInterestParameters& p,
+                         std::vector<RegionOfInterest>& regions,
+                         RegionOfInterestStats* stats)
+{
+  try {
+    return regionsOfInterest(result, tri, sensor_to_cloud, p, regions, stats);
+  } catch (const std::bad_alloc&) {
+    std::vector<RegionOfInterest>().swap(regions);
+    if (stats)
+      *stats = RegionOfInterestStats();
+    PCL_ERROR("[pcl::selective_seg::computeRegionsOfInterest] out of memory with %zu "
+              "points and %zu triangles\n",
+              tri.point_vertex.size(),
+              tri.triangles.size());
+    return false;
+  }
 }
 
 } // namespace selective_seg

@@ -281,8 +281,9 @@ fisherConfidenceAngle(std::size_t n, double resultant, double confidence);
  * (SelectiveSegmentation::getTriangulation()) \param[in] sensor_to_cloud the sensor
  * pose used by the segmentation \param[in] params the parameters \param[out] regions
  * the selected windows; empty on failure \param[out] stats if non-null: counts of
- * evidence and windows \return false (with PCL_ERROR saying why) on invalid parameters
- * or a result that does not belong to the triangulation. An empty scan gives no region.
+ * evidence and windows \return false (with PCL_ERROR saying why) on invalid parameters,
+ * a result that does not belong to the triangulation, or when memory runs out
+ * (std::bad_alloc is caught, on every thread). An empty scan gives no region.
  * With a panoramic triangulation the windows are rectangles of azimuth and elevation;
  * angle steps across the seam are taken the short way round.
  */

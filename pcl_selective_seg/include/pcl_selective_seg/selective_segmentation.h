@@ -194,11 +194,9 @@ public:
    * \param[out] clusters the segments' point indices, largest first (segment i has
    *             label i + 1)
    * \return false, with a PCL_ERROR saying why and empty outputs, on a missing or
-   *         unusable input or an invalid parameter, and when memory runs out in a
-   *         sequential part of the pipeline (std::bad_alloc is caught; the result is
-   *         cleared). Memory running out inside a parallel stage ends the process
-   *         (std::terminate: an exception cannot leave an OpenMP region;
-   *         docs/reliability.md, "Out of memory"). */
+   *         unusable input or an invalid parameter, and when memory runs out
+   *         (std::bad_alloc is caught, on every thread of the parallel stages too;
+   *         the result is cleared; docs/reliability.md, "Out of memory"). */
   bool extract(std::vector<pcl::PointIndices>& clusters);
 
   /** \brief Fold more points of the same scene, seen from the same sensor pose, into

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <pcl_selective_seg/delaunay_2d.h>
+#include <pcl_selective_seg/impl/parallel_exceptions.hpp>
 #include <pcl_selective_seg/impl/radix_sort.hpp>
 #include <pcl_selective_seg/octree_pointcloud_normal_variance.h>
 
@@ -350,6 +351,7 @@ OctreePointCloudNormalVariance<PointT>::insertPoints(bool with_angles)
   lazy_angles_ = !previous_.leaves.empty();
   const Eigen::Matrix3d to_sensor =
       sensor_orientation_.toRotationMatrix().transpose().template cast<double>();
+  detail::ParallelExceptions errors; // the tree's nodes may not fit in memory
 #ifdef _OPENMP
 #pragma omp parallel num_threads(num_threads_)
 #endif
@@ -359,13 +361,14 @@ OctreePointCloudNormalVariance<PointT>::insertPoints(bool with_angles)
 #ifdef _OPENMP
 #pragma omp master
 #endif
-    build_tree();
+    errors.run(build_tree);
 #ifdef _OPENMP
 #pragma omp for schedule(dynamic, 1024) nowait
 #endif
     for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(n); ++k)
       computeNormalAngle(static_cast<std::size_t>(k), to_sensor, ordered_indices_.data(), n);
   }
+  errors.rethrow();
   voxel_first_ = std::move(voxel_begin);
   angles_ready_ = true;
   return true;
