@@ -7,6 +7,8 @@
 #define PCL_NO_PRECOMPILE
 #include "outputs.h"
 
+#include <pcl_selective_seg/impl/parallel_exceptions.hpp>
+
 #include <pcl/console/print.h>
 #include <pcl/io/lzf.h>
 #include <pcl/io/pcd_io.h>
@@ -165,11 +167,15 @@ inOrderBatches(std::size_t count, int threads, const Make& make, const Write& wr
   const auto batch = static_cast<std::size_t>(width);
   for (std::size_t first = 0; first < count; first += batch) {
     const auto n = static_cast<std::ptrdiff_t>(std::min(batch, count - first));
+    pcl::selective_seg::detail::ParallelExceptions errors; // made items allocate
 #ifdef _OPENMP
 #pragma omp parallel for num_threads(width) schedule(static, 1) if (n > 1)
 #endif
     for (std::ptrdiff_t k = 0; k < n; ++k)
-      make(first + static_cast<std::size_t>(k), static_cast<std::size_t>(k));
+      errors.run([&] {
+        make(first + static_cast<std::size_t>(k), static_cast<std::size_t>(k));
+      });
+    errors.rethrow();
     for (std::ptrdiff_t k = 0; k < n; ++k)
       if (!write(static_cast<std::size_t>(k)))
         return;
