@@ -474,13 +474,10 @@ segment(const Options& opt)
   return 0;
 }
 
-} // namespace
-
+/** main() but for its handling of memory running out. */
 int
-main(int argc, char** argv)
+run(int argc, char** argv)
 {
-  // One pipeline a process: freed arrays are kept for the next stage's (same peak).
-  selseg_apps::keepFreedMemory();
   if (argc < 2) {
     printHelp(argv[0]);
     return kUsageError;
@@ -492,10 +489,21 @@ main(int argc, char** argv)
   Options opt;
   if (const int rc = parseOptions(argc, argv, opt))
     return rc;
-  // Out of memory outside the library's own handling (reading, the outputs): a
-  // message, and the outputs' temporaries removed on the way out of segment().
+  return segment(opt);
+}
+
+} // namespace
+
+int
+main(int argc, char** argv)
+{
+  // One pipeline a process: freed arrays are kept for the next stage's (same peak).
+  selseg_apps::keepFreedMemory();
+  // Out of memory outside the library's own handling (the options, reading, the
+  // outputs): a message, and the outputs' temporaries removed on the way out of
+  // segment().
   return selseg_apps::runReportingOutOfMemory(
-      [&] { return segment(opt); },
+      [&] { return run(argc, argv); },
       "segment a smaller scan (crop or downsample it) or give the process more memory.",
       kRuntimeError);
 }

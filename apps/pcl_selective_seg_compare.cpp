@@ -428,10 +428,9 @@ writeTable(const std::string& path, const std::string& table)
   return true;
 }
 
-} // namespace
-
+/** main() but for its handling of memory running out. */
 int
-main(int argc, char** argv)
+run(int argc, char** argv)
 {
   if (argc < 2 || find_switch(argc, argv, "-h") || find_switch(argc, argv, "--help")) {
     print_info("Compare segmenters on ground-truth clouds.\n\n"
@@ -461,17 +460,21 @@ main(int argc, char** argv)
   }
   std::string table = kHeader;
   std::fputs(kHeader, stdout);
-  if (const int code = selseg_apps::runReportingOutOfMemory(
-          [&] {
-            for (const auto& input : opt.inputs)
-              if (!evaluate(input, table))
-                return kRuntimeError;
-            return 0;
-          },
-          "compare smaller clouds (crop or downsample them).",
-          kRuntimeError))
-    return code;
+  for (const auto& input : opt.inputs)
+    if (!evaluate(input, table))
+      return kRuntimeError;
   if (!opt.output.empty() && !writeTable(opt.output, table))
     return kRuntimeError;
   return 0;
+}
+
+} // namespace
+
+int
+main(int argc, char** argv)
+{
+  return selseg_apps::runReportingOutOfMemory(
+      [&] { return run(argc, argv); },
+      "compare smaller clouds (crop or downsample them).",
+      kRuntimeError);
 }

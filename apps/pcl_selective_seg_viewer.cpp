@@ -923,10 +923,9 @@ SegmentationViewer::updateLegend()
   }
 }
 
-} // namespace
-
+/** main() but for its handling of memory running out. */
 int
-main(int argc, char** argv)
+run(int argc, char** argv)
 {
   if (argc < 2 || find_switch(argc, argv, "-h") || find_switch(argc, argv, "--help")) {
     printHelp(argv[0]);
@@ -944,19 +943,23 @@ main(int argc, char** argv)
     return kRuntimeError;
   }
   Scene scene;
-  if (const int code = selseg_apps::runReportingOutOfMemory(
-          [&] {
-            return loadInput(opt, scene) && checkDisplay() && segment(opt, scene)
-                       ? 0
-                       : kRuntimeError;
-          },
-          "view a smaller scan (crop or downsample it).",
-          kRuntimeError))
-    return code;
+  if (!loadInput(opt, scene) || !checkDisplay() || !segment(opt, scene))
+    return kRuntimeError;
   const bool offscreen = !opt.screenshot.empty();
   SegmentationViewer viewer(scene, opt, offscreen);
   if (offscreen)
     return viewer.saveScreenshot(opt.screenshot) ? 0 : kRuntimeError;
   viewer.spin();
   return 0;
+}
+
+} // namespace
+
+int
+main(int argc, char** argv)
+{
+  return selseg_apps::runReportingOutOfMemory(
+      [&] { return run(argc, argv); },
+      "view a smaller scan (crop or downsample it).",
+      kRuntimeError);
 }
