@@ -10,8 +10,9 @@
 // (2 for usage errors), and no output: neither a partial file nor a changed old one.
 // pcl_selective_seg_compare is checked on broken clouds and command lines too. A run
 // ended by a signal while it writes leaves no temporary file.
-// Arguments: the tool's path, the bundled scan, pcl_selective_seg_compare's path, then
-// pcl_selective_seg_simulate's path.
+// Arguments: the tool's path, the bundled scan, pcl_selective_seg_compare's path,
+// pcl_selective_seg_simulate's path, then the fault-injection module's
+// (fail_allocation.cpp).
 
 #include <gtest/gtest.h>
 #include <pcl/io/pcd_io.h>
@@ -26,6 +27,7 @@
 #include <sstream>
 #include <string>
 
+#include <cube_scene.h>
 #include <fcntl.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
@@ -40,6 +42,7 @@ std::string tool;     // NOLINT: set once in main()
 std::string scan;     // NOLINT: set once in main()
 std::string compare;  // NOLINT: set once in main(); pcl_selective_seg_compare
 std::string simulate; // NOLINT: set once in main(); pcl_selective_seg_simulate
+std::string fail_allocation; // NOLINT: set once in main(); fail_allocation.cpp's module
 
 struct Outcome {
   int code = -1;        ///< exit code, -1 when killed by a signal
@@ -804,6 +807,60 @@ TEST_F(ToolFailure, SimulatorSignalLeavesNoTemporary)
     GTEST_SKIP() << "every run ended before a temporary file was seen";
 }
 
+// Out of memory at an allocation after main() starts (the options, reading, the
+// pipeline on both threads, the regions of interest, the outputs): the tool exits 1
+// with a message and leaves nothing, or succeeds with every output when the failed
+// allocation did not matter. Before main() the shared libraries' static initialisers
+// allocate (VTK's, PCL's); no program can report a failure there. The module's
+// operator new stands in front of the sanitizers' allocators: not in their run.
+TEST_F(ToolFailure, OutOfMemoryAfterStartIsReported)
+{
+  if (fail_allocation.empty() || !fs::exists(fail_allocation))
+    GTEST_SKIP() << "the fault-injection module is missing";
+  const auto labeled = selseg_test::cubeScan(4000, 5);
+  pcl::PointCloud<pcl::PointXYZ> cube;
+  for (const auto& p : *labeled)
+    cube.push_back(pcl::PointXYZ(p.x, p.y, p.z));
+  const fs::path in = dir / "in" / "cube.pcd";
+  ASSERT_EQ(pcl::io::savePCDFileBinary(in.string(), cube), 0);
+  const std::string args =
+      shellQuoted(in) + " -ignore_viewpoint -threads 2" + allOutputs() + " -roi_json " +
+      shellQuoted(dir / "out" / "roi.json") + " -roi_max_regions 5";
+  const auto withModule = [&](const std::string& setting) {
+    return runProgram("env",
+                      setting + " LD_PRELOAD=" + shellQuoted(fail_allocation) + " " +
+                          shellQuoted(tool) + " " + args);
+  };
+  const fs::path count_file = dir / "in" / "count.txt";
+  const Outcome counted =
+      withModule("SELSEG_COUNT_ALLOCATIONS=" + shellQuoted(count_file));
+  ASSERT_EQ(counted.code, 0) << counted.messages;
+  const std::size_t num_outputs = outputs().size();
+  ASSERT_EQ(num_outputs, 6u);
+  long total = 0;
+  std::ifstream(count_file) >> total;
+  ASSERT_GT(total, 1000);
+  fs::remove_all(dir / "out");
+  fs::create_directories(dir / "out");
+  int reported = 0;
+  for (long k = 0; k < 60; ++k) {
+    const long n = k * total / 60;
+    const Outcome o = withModule("SELSEG_FAIL_ALLOCATION=" + std::to_string(n));
+    if (o.code == 0) {
+      EXPECT_EQ(outputs().size(), num_outputs) << "allocation " << n;
+      fs::remove_all(dir / "out");
+      fs::create_directories(dir / "out");
+      continue;
+    }
+    ASSERT_EQ(o.code, 1) << "allocation " << n << " of " << total << ": " << o.messages;
+    EXPECT_NE(o.messages.find("memory"), std::string::npos)
+        << "allocation " << n << ": " << o.messages;
+    EXPECT_TRUE(outputs().empty()) << "allocation " << n;
+    ++reported;
+  }
+  EXPECT_GT(reported, 50);
+}
+
 int
 main(int argc, char** argv)
 {
@@ -816,5 +873,7 @@ main(int argc, char** argv)
     compare = argv[3];
   if (argc > 4)
     simulate = argv[4];
+  if (argc > 5)
+    fail_allocation = argv[5];
   return RUN_ALL_TESTS();
 }
