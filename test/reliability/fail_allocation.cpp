@@ -16,6 +16,7 @@
 #include <cstdlib>
 #include <new>
 
+#include "replaced_operator_new.h"
 #include <dlfcn.h>
 
 namespace {
@@ -24,18 +25,6 @@ std::atomic<bool> g_started{false};
 std::atomic<long> g_count{0};
 long g_fail_at = -1;
 const char* g_count_file = nullptr;
-
-void*
-allocate(std::size_t n)
-{
-  if (g_started.load(std::memory_order_relaxed) &&
-      g_count.fetch_add(1, std::memory_order_relaxed) == g_fail_at)
-    throw std::bad_alloc();
-  void* p = std::malloc(n ? n : 1);
-  if (!p)
-    throw std::bad_alloc();
-  return p;
-}
 
 void
 writeCount()
@@ -64,34 +53,12 @@ countingMain(int argc, char** argv, char** env)
 } // namespace
 
 void*
-operator new(std::size_t n)
+selsegTestAllocate(std::size_t n, std::size_t alignment)
 {
-  return allocate(n);
-}
-void*
-operator new[](std::size_t n)
-{
-  return allocate(n);
-}
-void
-operator delete(void* p) noexcept
-{
-  std::free(p);
-}
-void
-operator delete[](void* p) noexcept
-{
-  std::free(p);
-}
-void
-operator delete(void* p, std::size_t) noexcept
-{
-  std::free(p);
-}
-void
-operator delete[](void* p, std::size_t) noexcept
-{
-  std::free(p);
+  if (g_started.load(std::memory_order_relaxed) &&
+      g_count.fetch_add(1, std::memory_order_relaxed) == g_fail_at)
+    throw std::bad_alloc();
+  return selsegTestMalloc(n, alignment);
 }
 
 // The C library's entry, which calls main(): wrapped to start the count.

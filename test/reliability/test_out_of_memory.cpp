@@ -28,6 +28,7 @@
 #include <new>
 #include <vector>
 
+#include "replaced_operator_new.h"
 #include <cube_scene.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -37,83 +38,15 @@ namespace {
 std::atomic<long> g_countdown{-1}; ///< allocations left before one fails; < 0: none fails
 std::atomic<long> g_count{0};      ///< allocations so far
 
+} // namespace
+
 void*
-allocate(std::size_t n, std::size_t alignment)
+selsegTestAllocate(std::size_t n, std::size_t alignment)
 {
   g_count.fetch_add(1, std::memory_order_relaxed);
   if (g_countdown.load(std::memory_order_relaxed) >= 0 && g_countdown.fetch_sub(1) == 0)
     throw std::bad_alloc();
-  void* p = nullptr;
-  if (alignment <= alignof(std::max_align_t))
-    p = std::malloc(n ? n : 1);
-  else if (posix_memalign(&p, alignment, n ? n : 1) != 0)
-    p = nullptr;
-  if (!p)
-    throw std::bad_alloc();
-  return p;
-}
-
-} // namespace
-
-void*
-operator new(std::size_t n)
-{
-  return allocate(n, 0);
-}
-void*
-operator new[](std::size_t n)
-{
-  return allocate(n, 0);
-}
-void*
-operator new(std::size_t n, std::align_val_t a)
-{
-  return allocate(n, static_cast<std::size_t>(a));
-}
-void*
-operator new[](std::size_t n, std::align_val_t a)
-{
-  return allocate(n, static_cast<std::size_t>(a));
-}
-void
-operator delete(void* p) noexcept
-{
-  std::free(p);
-}
-void
-operator delete[](void* p) noexcept
-{
-  std::free(p);
-}
-void
-operator delete(void* p, std::size_t) noexcept
-{
-  std::free(p);
-}
-void
-operator delete[](void* p, std::size_t) noexcept
-{
-  std::free(p);
-}
-void
-operator delete(void* p, std::align_val_t) noexcept
-{
-  std::free(p);
-}
-void
-operator delete[](void* p, std::align_val_t) noexcept
-{
-  std::free(p);
-}
-void
-operator delete(void* p, std::size_t, std::align_val_t) noexcept
-{
-  std::free(p);
-}
-void
-operator delete[](void* p, std::size_t, std::align_val_t) noexcept
-{
-  std::free(p);
+  return selsegTestMalloc(n, alignment);
 }
 
 namespace {
