@@ -66,7 +66,7 @@ public:
   void
   rethrow() const
   {
-    if (failed_.load(std::memory_order_acquire) && first_)
+    if (first_)
       std::rethrow_exception(first_);
   }
 
