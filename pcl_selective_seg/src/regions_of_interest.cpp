@@ -1573,7 +1573,8 @@ computeRegionsOfInterest(const SegmentationResult& result,
     if (stats)
       *stats = RegionOfInterestStats();
     PCL_ERROR("[pcl::selective_seg::computeRegionsOfInterest] out of memory with %zu "
-              "points and %zu triangles\n",
+              "points and %zu triangles: segment a smaller scan (crop or downsample "
+              "it) or give the process more memory\n",
               tri.point_vertex.size(),
               tri.triangles.size());
     return false;
