@@ -5,6 +5,7 @@
  */
 
 #include <pcl_selective_seg/delaunay_2d.h>
+#include <pcl_selective_seg/impl/large_arrays.hpp>
 
 #include <boost/polygon/voronoi.hpp>
 
@@ -137,7 +138,8 @@ canonicalize(std::vector<Triangle>& triangles,
   }
   offsets = std::vector<std::size_t>();
   const auto num_triangles = static_cast<std::ptrdiff_t>(order.size());
-  std::vector<Triangle> sorted(order.size());
+  std::vector<Triangle> sorted;
+  detail::resizeLarge(sorted, order.size());
 #ifdef _OPENMP
 #pragma omp parallel for num_threads(threads) schedule(static) if (parallel)
 #endif
@@ -147,7 +149,8 @@ canonicalize(std::vector<Triangle>& triangles,
   if (!neighbours)
     return;
   // The neighbours' new numbers, then the rows in the new order.
-  std::vector<index_t> position_of(static_cast<std::size_t>(num_slots));
+  std::vector<index_t> position_of;
+  detail::resizeLarge(position_of, static_cast<std::size_t>(num_slots));
 #ifdef _OPENMP
 #pragma omp parallel for num_threads(threads) schedule(static) if (parallel)
 #endif

@@ -9,6 +9,7 @@
  * repairs and classifies them, then the canonical fans. See docs/delaunay.md. */
 
 #include <pcl_selective_seg/delaunay_2d.h>
+#include <pcl_selective_seg/impl/large_arrays.hpp>
 #include <pcl_selective_seg/impl/parallel_exceptions.hpp>
 
 #include <algorithm>
@@ -76,7 +77,8 @@ sortKeys(const std::vector<QuantizedPoint>& points, int& bits)
   }
   const int y_bits = bitWidth(static_cast<std::uint64_t>(max_y - min_y));
   bits = y_bits + bitWidth(static_cast<std::uint64_t>(max_x - min_x));
-  std::vector<std::uint64_t> keys(points.size());
+  std::vector<std::uint64_t> keys;
+  detail::resizeLarge(keys, points.size());
   for (std::size_t i = 0; i < points.size(); ++i)
     keys[i] = (static_cast<std::uint64_t>(points[i][0] - min_x) << y_bits) |
               static_cast<std::uint64_t>(points[i][1] - min_y);
@@ -91,14 +93,17 @@ sortedOrder(const std::vector<QuantizedPoint>& points, std::vector<std::uint64_t
   int bits = 0;
   keys = sortKeys(points, bits);
   const std::size_t n = points.size();
-  std::vector<index_t> order(n);
+  std::vector<index_t> order;
+  detail::resizeLarge(order, n);
   for (std::size_t i = 0; i < n; ++i)
     order[i] = static_cast<index_t>(i);
   const int passes = std::max(1, (bits + 10) / 11);
   const int digit_bits = (bits + passes - 1) / passes;
   const std::uint64_t mask = (std::uint64_t{1} << digit_bits) - 1;
-  std::vector<std::uint64_t> key_buffer(n);
-  std::vector<index_t> order_buffer(n);
+  std::vector<std::uint64_t> key_buffer;
+  detail::resizeLarge(key_buffer, n);
+  std::vector<index_t> order_buffer;
+  detail::resizeLarge(order_buffer, n);
   std::vector<std::size_t> offsets(mask + 2);
   for (int pass = 0; pass < passes; ++pass) {
     const int shift = pass * digit_bits;
@@ -329,18 +334,21 @@ SweepTriangulation::SweepTriangulation(const QuantizedPoint* first,
     : num_threads_(std::max(1, num_threads))
 {
   const auto n = static_cast<index_t>(count);
-  points_.reserve(count + 2);
+  detail::reserveLarge(points_, count + 2);
   points_.assign(first, first + count);
   if (storage == nullptr) {
-    own_triangles_.resize(maxTriangles(count));
+    detail::resizeLarge(own_triangles_, maxTriangles(count));
     storage = own_triangles_.data();
   }
   triangles_ = storage;
-  twins_.reset(new index_t[8 * static_cast<std::size_t>(n) + 16]);
-  circle_.reset(new CircleState[8 * static_cast<std::size_t>(n) + 16]);
-  front_next_.assign(n + 2, kNone);
-  front_previous_.assign(n + 2, kNone);
-  boundary_edge_.assign(n + 2, kNone);
+  const std::size_t half_edges = 8 * static_cast<std::size_t>(n) + 16;
+  twins_.reset(new index_t[half_edges]);
+  detail::adviseHugePages(twins_.get(), half_edges * sizeof(index_t));
+  circle_.reset(new CircleState[half_edges]);
+  detail::adviseHugePages(circle_.get(), half_edges * sizeof(CircleState));
+  detail::assignLarge(front_next_, n + 2, kNone);
+  detail::assignLarge(front_previous_, n + 2, kNone);
+  detail::assignLarge(boundary_edge_, n + 2, kNone);
   stack_.reserve(64);
   flip_budget_ = 16 * std::int64_t{n} + 65536;
 }
@@ -821,7 +829,7 @@ SweepTriangulation::refan(const std::vector<QuantizedPoint>& points,
 void
 SweepTriangulation::neighbours(std::vector<Triangle>& out) const
 {
-  out.resize(static_cast<std::size_t>(num_triangles_));
+  detail::resizeLarge(out, static_cast<std::size_t>(num_triangles_));
   neighbours(out.data());
 }
 
@@ -1097,8 +1105,8 @@ triangulateSortedInSlabs(const std::vector<QuantizedPoint>& points,
   // The shared arrays and the sweeps' own are allocated here, on the calling thread:
   // memory a worker thread allocates comes from its own malloc arena, which the later
   // stages of a segmentation would not reuse.
-  triangles.resize(static_cast<std::size_t>(slots));
-  neighbours.resize(static_cast<std::size_t>(slots));
+  detail::resizeLarge(triangles, static_cast<std::size_t>(slots));
+  detail::resizeLarge(neighbours, static_cast<std::size_t>(slots));
   std::vector<std::unique_ptr<SweepTriangulation>> meshes(slabs.size());
   for (std::size_t s = 0; s < slabs.size(); ++s) {
     slabs[s].visited.reserve(static_cast<std::size_t>(slabs[s].capacity));
@@ -1304,7 +1312,8 @@ delaunaySweep(const std::vector<QuantizedPoint>& points,
     reportDuplicate(points, points[order[duplicate - keys.begin()]], error);
     return false;
   }
-  std::vector<QuantizedPoint> sorted(points.size());
+  std::vector<QuantizedPoint> sorted;
+  detail::resizeLarge(sorted, points.size());
   for (std::size_t i = 0; i < points.size(); ++i)
     sorted[i] = points[order[i]];
   if (points.size() < 3 || allCollinear(sorted))

@@ -9,6 +9,7 @@
 
 #pragma once
 
+#include <pcl_selective_seg/impl/large_arrays.hpp>
 #include <pcl_selective_seg/region_merging.h>
 
 #include <algorithm>
@@ -78,8 +79,9 @@ placeInBuckets(std::size_t num_items,
   };
   // cursors[c][g]: first the number of entries of group g in chunk c, then where the
   // chunk's first one goes.
-  std::vector<std::vector<std::size_t>> cursors(chunks,
-                                                std::vector<std::size_t>(num_groups, 0));
+  std::vector<std::vector<std::size_t>> cursors(chunks);
+  for (auto& cursor : cursors)
+    assignLarge(cursor, num_groups, std::size_t{0});
 #ifdef _OPENMP
 #pragma omp parallel for num_threads(static_cast<int>(chunks)) schedule(static, 1)
 #endif
@@ -88,7 +90,7 @@ placeInBuckets(std::size_t num_items,
     for (std::size_t i = chunk_begin(c); i < chunk_begin(c + 1); ++i)
       emit(i, [&](pcl::index_t g, const Value&) { ++count[static_cast<std::size_t>(g)]; });
   }
-  offsets.resize(num_groups + 1);
+  resizeLarge(offsets, num_groups + 1);
   std::size_t total = 0;
   for (std::size_t g = 0; g < num_groups; ++g) {
     offsets[g] = total;
@@ -112,6 +114,22 @@ placeInBuckets(std::size_t num_items,
   }
 }
 
+/** \brief values.resize(n): a std::vector into storage advised as huge-page memory
+ * (resizeLarge()), a BlockArray in its blocks. */
+template <typename T>
+void
+resizeBuckets(std::vector<T>& values, std::size_t n)
+{
+  resizeLarge(values, n);
+}
+
+template <typename Values>
+void
+resizeBuckets(Values& values, std::size_t n)
+{
+  values.resize(n);
+}
+
 /** \brief placeInBuckets() into one array: bucket g is values[offsets[g] ..
  * offsets[g + 1]). */
 template <typename Value, typename Emit, typename Values = std::vector<Value>>
@@ -129,8 +147,12 @@ buildBuckets(std::size_t num_items,
       emit,
       num_threads,
       offsets,
-      [&](const std::vector<std::size_t>& sizes) { values.resize(sizes.back()); },
-      [&](pcl::index_t, std::size_t slot, const Value& value) { values[slot] = value; });
+      [&](const std::vector<std::size_t>& sizes) {
+        resizeBuckets(values, sizes.back());
+      },
+      [&](pcl::index_t, std::size_t slot, const Value& value) {
+        values[slot] = value;
+      });
 }
 
 /** \brief Compressed incidence lists: groups_of(item, f) calls f(group) for each group

@@ -4,6 +4,7 @@
  *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
  */
 
+#include <pcl_selective_seg/impl/large_arrays.hpp>
 #include <pcl_selective_seg/impl/parallel_exceptions.hpp>
 #include <pcl_selective_seg/mesh_normals.h>
 #include <pcl_selective_seg/region_merging.h>
@@ -204,8 +205,9 @@ computeTriangleNormals(const Vector3fVector& positions,
                        int num_threads)
 {
   const float nan = std::numeric_limits<float>::quiet_NaN();
-  normals.assign(triangles.size(), Eigen::Vector3f::Constant(nan));
-  areas.assign(triangles.size(), 0.0);
+  detail::assignLarge(
+      normals, triangles.size(), Eigen::Vector3f(Eigen::Vector3f::Constant(nan)));
+  detail::assignLarge(areas, triangles.size(), 0.0);
   const Eigen::Vector3d eye = viewpoint.cast<double>();
   const auto n_tri = static_cast<std::ptrdiff_t>(triangles.size());
 #pragma omp parallel for num_threads(threadCount(num_threads)) schedule(static)
@@ -224,9 +226,9 @@ computeTriangleNormalsAndEdgeOn(const Vector3fVector& positions,
                                 int num_threads)
 {
   // Every entry is written below.
-  normals.resize(triangles.size());
-  areas.resize(triangles.size());
-  edge_on.resize(triangles.size());
+  detail::resizeLarge(normals, triangles.size());
+  detail::resizeLarge(areas, triangles.size());
+  detail::resizeLarge(edge_on, triangles.size());
   const double min_cos = minIncidenceCos(max_incidence);
   const Eigen::Vector3d eye = viewpoint.cast<double>();
   const auto n_tri = static_cast<std::ptrdiff_t>(triangles.size());
@@ -441,12 +443,14 @@ scatterVertexNormals(std::size_t num_vertices,
   for (std::size_t c = 2; c < runs; ++c)
     if (run_lowest[c] < run_lowest[c - 1])
       return false;
-  std::vector<Eigen::Vector3d> sums(num_vertices, Eigen::Vector3d::Zero());
-  vertex_areas.assign(num_vertices, 0.0);
+  std::vector<Eigen::Vector3d> sums;
+  detail::assignLarge(sums, num_vertices, Eigen::Vector3d(Eigen::Vector3d::Zero()));
+  detail::assignLarge(vertex_areas, num_vertices, 0.0);
   std::vector<std::vector<std::pair<pcl::index_t, pcl::index_t>>> deferred(runs);
   // With several runs, the corners each vertex gets directly; with its deferred corners
   // they tell whether the walk around a deferred vertex finds all its triangles.
-  std::vector<pcl::index_t> corners(runs > 1 ? num_vertices : 0, 0);
+  std::vector<pcl::index_t> corners;
+  detail::assignLarge(corners, runs > 1 ? num_vertices : 0, pcl::index_t{0});
   pcl::index_t* const direct = runs > 1 ? corners.data() : nullptr;
   std::vector<char> out_of_order(runs, 0);
   detail::ParallelExceptions errors;
@@ -480,7 +484,7 @@ scatterVertexNormals(std::size_t num_vertices,
   errors.rethrow();
   if (std::find(out_of_order.begin(), out_of_order.end(), 1) != out_of_order.end())
     return false;
-  vertex_normals.resize(num_vertices);
+  detail::resizeLarge(vertex_normals, num_vertices);
 #pragma omp parallel for num_threads(static_cast<int>(runs)) schedule(static)
   for (std::ptrdiff_t v = 0; v < static_cast<std::ptrdiff_t>(num_vertices); ++v)
     vertex_normals[v] = normalizedOrNaN(sums[v]);
@@ -529,8 +533,8 @@ computeVertexNormals(std::size_t num_vertices,
   // same order, whatever the number of threads.
   const Incidence incident =
       vertexTriangles(triangles, num_vertices, threadCount(num_threads));
-  vertex_areas.assign(num_vertices, 0.0);
-  vertex_normals.resize(num_vertices);
+  detail::assignLarge(vertex_areas, num_vertices, 0.0);
+  detail::resizeLarge(vertex_normals, num_vertices);
 #pragma omp parallel for num_threads(threadCount(num_threads)) schedule(static)
   for (std::ptrdiff_t v = 0; v < static_cast<std::ptrdiff_t>(num_vertices); ++v)
     vertexNormal(incident.items.data() + incident.offsets[v],
@@ -708,7 +712,7 @@ maskEdgeOnNormals(const Vector3fVector& normals,
 {
   const Eigen::Vector3f nan =
       Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN());
-  masked.resize(normals.size());
+  detail::resizeLarge(masked, normals.size());
   const auto n_tri = static_cast<std::ptrdiff_t>(normals.size());
 #pragma omp parallel for num_threads(threadCount(num_threads))                         \
     schedule(static) if (normals.size() >= detail::kMinParallelItems)
@@ -787,7 +791,7 @@ markEdgeOnTriangles(const Vector3fVector& positions,
                     std::vector<std::uint8_t>& edge_on,
                     int num_threads)
 {
-  edge_on.assign(triangles.size(), 0);
+  detail::assignLarge(edge_on, triangles.size(), std::uint8_t{0});
   const double min_cos = minIncidenceCos(max_incidence);
   const Eigen::Vector3d eye = viewpoint.cast<double>();
   const auto n_tri = static_cast<std::ptrdiff_t>(triangles.size());
@@ -840,6 +844,7 @@ medianEdgeLength(const Vector3fVector& positions,
   // Every entry is written below: no zero fill.
   const std::size_t num_squares = 3 * static_cast<std::size_t>(sampled);
   const std::unique_ptr<double[]> squares(new double[num_squares]);
+  detail::adviseHugePages(squares.get(), num_squares * sizeof(double));
   // Squares are non-negative, so their bit patterns order as they do: the range of the
   // patterns, then a histogram over it, finds the bucket that holds the element of rank
   // n / 2, and only that bucket is partitioned.

@@ -4,6 +4,7 @@
  *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
  */
 
+#include <pcl_selective_seg/impl/large_arrays.hpp>
 #include <pcl_selective_seg/impl/parallel_exceptions.hpp>
 #include <pcl_selective_seg/region_merging.h>
 #include <pcl_selective_seg/spherical_delaunay.h>
@@ -786,8 +787,8 @@ classifyTriangles(const std::vector<Triangle>& triangles,
                   int num_threads)
 {
   const double cos_edge = std::cos(max_edge_triangle_angle);
-  labels.assign(triangles.size(), 0);
-  classes.assign(triangles.size(), TriangleClass::InvalidEdge);
+  detail::assignLarge(labels, triangles.size(), std::uint32_t{0});
+  detail::assignLarge(classes, triangles.size(), TriangleClass::InvalidEdge);
   const int threads = detail::threadCount(num_threads);
   const auto num_triangles = static_cast<std::ptrdiff_t>(triangles.size());
   // Each triangle's label and class are its own: the same for any thread count.

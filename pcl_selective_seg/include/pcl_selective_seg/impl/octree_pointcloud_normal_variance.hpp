@@ -7,6 +7,7 @@
 #pragma once
 
 #include <pcl_selective_seg/delaunay_2d.h>
+#include <pcl_selective_seg/impl/large_arrays.hpp>
 #include <pcl_selective_seg/impl/parallel_exceptions.hpp>
 #include <pcl_selective_seg/impl/radix_sort.hpp>
 #include <pcl_selective_seg/octree_pointcloud_normal_variance.h>
@@ -163,7 +164,8 @@ OctreePointCloudNormalVariance<PointT>::insertPoints(bool with_angles)
   const auto candidate = [&](std::ptrdiff_t k) {
     return this->indices_ ? (*this->indices_)[k] : static_cast<pcl::index_t>(k);
   };
-  std::vector<std::uint8_t> is_valid(static_cast<std::size_t>(num_candidates));
+  std::vector<std::uint8_t> is_valid;
+  detail::resizeLarge(is_valid, static_cast<std::size_t>(num_candidates));
   Eigen::Array3d lo = Eigen::Array3d::Constant(std::numeric_limits<double>::max());
   Eigen::Array3d hi = -lo;
 #ifdef _OPENMP
@@ -194,8 +196,9 @@ OctreePointCloudNormalVariance<PointT>::insertPoints(bool with_angles)
     }
   }
   pcl::Indices valid;
-  valid.reserve(static_cast<std::size_t>(
-      std::count(is_valid.begin(), is_valid.end(), std::uint8_t{1})));
+  detail::reserveLarge(valid,
+                       static_cast<std::size_t>(std::count(
+                           is_valid.begin(), is_valid.end(), std::uint8_t{1})));
   for (std::ptrdiff_t k = 0; k < num_candidates; ++k)
     if (is_valid[k])
       valid.push_back(candidate(k));
@@ -255,7 +258,8 @@ OctreePointCloudNormalVariance<PointT>::insertPoints(bool with_angles)
   }
   // Finest voxels in depth-first (Morton) order, points by increasing index within
   // each (a stable radix sort of the codes of the points in increasing index order).
-  std::vector<std::pair<std::uint64_t, pcl::index_t>> order(valid.size());
+  std::vector<std::pair<std::uint64_t, pcl::index_t>> order;
+  detail::resizeLarge(order, valid.size());
   // The passes over the points below take microseconds on small clouds: less than
   // starting a team of threads.
   [[maybe_unused]] const bool parallel = valid.size() >= detail::kMinParallelItems;
@@ -275,7 +279,7 @@ OctreePointCloudNormalVariance<PointT>::insertPoints(bool with_angles)
   const std::size_t n = order.size();
   leaves_view_ordered_ = with_angles; // the tree is empty: no container views either
   pcl::Indices& leaf_indices = with_angles ? ordered_indices_ : voxel_indices_;
-  leaf_indices.resize(n);
+  detail::resizeLarge(leaf_indices, n);
 #ifdef _OPENMP
 #pragma omp parallel for num_threads(num_threads_) schedule(static) if (parallel)
 #endif
@@ -294,7 +298,7 @@ OctreePointCloudNormalVariance<PointT>::insertPoints(bool with_angles)
   for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(n); ++k)
     num_voxels += starts_voxel(static_cast<std::size_t>(k));
   std::vector<pcl::uindex_t> voxel_begin; // exactly sized: it lives beside the scratch
-  voxel_begin.reserve(num_voxels);
+  detail::reserveLarge(voxel_begin, num_voxels);
   for (std::size_t k = 0; k < n; ++k)
     if (starts_voxel(k))
       voxel_begin.push_back(static_cast<pcl::uindex_t>(k));
@@ -344,7 +348,7 @@ OctreePointCloudNormalVariance<PointT>::insertPoints(bool with_angles)
   // values), computed by the other threads while the calling thread builds the tree,
   // which then joins them.
   voxel_indices_ = pcl::Indices();
-  voxel_codes_.resize(num_voxels);
+  detail::resizeLarge(voxel_codes_, num_voxels);
   resizeScratch(n);
   // With leaves to keep (keepLeavesFrom()), the points under kept nodes never need
   // their angles: each is computed when a statistics pass first reaches it.
@@ -401,12 +405,12 @@ template <typename PointT>
 void
 OctreePointCloudNormalVariance<PointT>::resizeScratch(std::size_t n)
 {
-  ordered_normals_.resize(n);
+  detail::resizeLarge(ordered_normals_, n);
   // The sensor-frame angles are read only in that frame (computeStatistics()).
   const std::size_t angles = spread_frame_ == NormalSpreadFrame::Sensor ? n : 0;
-  ordered_theta_.resize(angles);
-  ordered_phi_.resize(angles);
-  ordered_weights_.resize(n);
+  detail::resizeLarge(ordered_theta_, angles);
+  detail::resizeLarge(ordered_phi_, angles);
+  detail::resizeLarge(ordered_weights_, n);
 }
 
 template <typename PointT>

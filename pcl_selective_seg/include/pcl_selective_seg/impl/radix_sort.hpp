@@ -6,6 +6,8 @@
 
 #pragma once
 
+#include <pcl_selective_seg/impl/large_arrays.hpp>
+
 #include <pcl/types.h>
 
 #include <algorithm>
@@ -52,7 +54,8 @@ radixSortByKey(std::vector<std::pair<std::uint64_t, pcl::index_t>>& entries,
   const std::size_t chunks = num_threads > 1 && n >= 8192 ? num_threads : 1;
   const std::size_t chunk_size = (n + chunks - 1) / chunks;
   const auto chunk_begin = [&](std::size_t c) { return std::min(n, c * chunk_size); };
-  std::vector<std::pair<std::uint64_t, pcl::index_t>> buffer(n);
+  std::vector<std::pair<std::uint64_t, pcl::index_t>> buffer;
+  resizeLarge(buffer, n);
   // slots[c * digits + d]: entries of digit d in chunk c, then where the first goes.
   std::vector<std::size_t> slots(chunks * digits);
   for (int pass = 0; pass < passes; ++pass) {

@@ -6,6 +6,7 @@
 
 #pragma once
 
+#include <pcl_selective_seg/impl/large_arrays.hpp>
 #include <pcl_selective_seg/impl/spherical_delaunay.hpp>
 #include <pcl_selective_seg/region_merging.h>
 #include <pcl_selective_seg/selective_segmentation.h>
@@ -271,6 +272,7 @@ SelectiveSegmentation<PointT>::buildOctree()
   const SphericalTriangulation& tri = delaunay_.getTriangulation();
   const std::size_t num_vertices = tri.vertex_positions.size();
   auto vertices = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  detail::reserveLarge(vertices->points, num_vertices);
   vertices->resize(num_vertices);
   // The box of the vertices with a normal: per-thread minima and maxima, combined (the
   // same for any thread count).
@@ -351,7 +353,7 @@ SelectiveSegmentation<PointT>::buildOctree()
                 "the octree holds no point: no point has a normal, or the octree "
                 "refused the points' extent (reason above)");
 
-  vertex_leaf_.assign(num_vertices, -1);
+  detail::assignLarge(vertex_leaf_, num_vertices, pcl::index_t{-1});
   const auto& leaves = octree_->getAdaptiveLeaves();
   const auto& ordered = octree_->getOrderedIndices();
   // Each vertex is in one leaf at most: the leaves can be split among the threads.
@@ -418,7 +420,7 @@ SelectiveSegmentation<PointT>::rankSegments(
     result_.segments[r].sensor_normal = segment_normals[order[r]];
   }
   // Per-point labels and the counts of labeled, shared-vertex and normal-less points.
-  result_.labels.resize(input_->size());
+  detail::resizeLarge(result_.labels, input_->size());
   std::size_t without_normal = 0, labeled = 0, shared_vertex = 0;
   const auto num_points = static_cast<std::ptrdiff_t>(input_->size());
 #ifdef _OPENMP
@@ -471,7 +473,7 @@ SelectiveSegmentation<PointT>::fillMeshAndLeaves(
   // result (the normals turned to the cloud frame): the run needs them no more, and
   // they are the largest arrays. When the frames coincide the normals are moved as
   // they are, and update() can take them back for the triangles it keeps.
-  mesh.triangles.resize(tri.triangles.size());
+  detail::resizeLarge(mesh.triangles, tri.triangles.size());
   const bool turn = to_cloud != Eigen::Matrix3f::Identity();
 #ifdef _OPENMP
 #pragma omp parallel for num_threads(numThreads()) schedule(static)
@@ -555,7 +557,8 @@ SelectiveSegmentation<PointT>::mergeAndLabel()
   previous_merge_ = PreviousMerge();
 
   const auto num_vertices = static_cast<std::ptrdiff_t>(vertex_leaf_.size());
-  std::vector<pcl::index_t> vertex_segment(vertex_leaf_.size());
+  std::vector<pcl::index_t> vertex_segment;
+  detail::resizeLarge(vertex_segment, vertex_leaf_.size());
 #ifdef _OPENMP
 #pragma omp parallel for num_threads(numThreads()) schedule(static)
 #endif
@@ -563,7 +566,8 @@ SelectiveSegmentation<PointT>::mergeAndLabel()
     vertex_segment[v] = vertex_leaf_[v] >= 0 ? leaf_segment[vertex_leaf_[v]] : -1;
   std::vector<std::uint32_t> segment_label;
   rankSegments(vertex_segment, segment_normals, segment_label);
-  std::vector<std::uint32_t> vertex_labels(vertex_segment.size());
+  std::vector<std::uint32_t> vertex_labels;
+  detail::resizeLarge(vertex_labels, vertex_segment.size());
 #ifdef _OPENMP
 #pragma omp parallel for num_threads(numThreads()) schedule(static)
 #endif

@@ -6,6 +6,7 @@
 
 #pragma once
 
+#include <pcl_selective_seg/impl/large_arrays.hpp>
 #include <pcl_selective_seg/impl/radix_sort.hpp>
 #include <pcl_selective_seg/spherical_delaunay.h>
 
@@ -157,13 +158,14 @@ SphericalDelaunay<PointT>::projectAndMergeVertices(SphericalTriangulation& resul
   const auto& indices = *this->indices_;
   const Eigen::Affine3d pose = getSensorPose().template cast<double>();
   // (angle key, point index), one per index; computed in parallel, point by point.
-  std::vector<std::pair<std::uint64_t, pcl::index_t>> keyed(indices.size());
+  std::vector<std::pair<std::uint64_t, pcl::index_t>> keyed;
+  detail::resizeLarge(keyed, indices.size());
 #ifdef _OPENMP
 #pragma omp parallel for num_threads(num_threads_) schedule(dynamic, 1024)
 #endif
   for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(indices.size()); ++k)
     keyed[k] = projectPoint(pose, indices[k]);
-  result.point_vertex.assign(cloud.size(), kOutsideIndices);
+  detail::assignLarge(result.point_vertex, cloud.size(), kOutsideIndices);
   result.angle_quantization = angle_quantization_;
   result.projection = projection_;
   for (std::size_t k = 0; k < keyed.size(); ++k)
@@ -271,14 +273,15 @@ SphericalDelaunay<PointT>::mergeEqualAngles(
   // One vertex per run of equal keys; the runs are filled in parallel (a point belongs
   // to one run, so every entry is written once).
   std::vector<std::size_t> run_begin;
+  detail::reserveLarge(run_begin, sorted.size() + 1);
   for (std::size_t k = 0; k < sorted.size(); ++k)
     if (k == 0 || sorted[k].first != sorted[k - 1].first)
       run_begin.push_back(k);
   const std::size_t num_vertices = run_begin.size();
   run_begin.push_back(sorted.size());
-  result.vertex_point.resize(num_vertices);
-  result.vertex_angles.resize(num_vertices);
-  result.vertex_positions.resize(num_vertices);
+  detail::resizeLarge(result.vertex_point, num_vertices);
+  detail::resizeLarge(result.vertex_angles, num_vertices);
+  detail::resizeLarge(result.vertex_positions, num_vertices);
 #ifdef _OPENMP
 #pragma omp parallel for num_threads(num_threads_) schedule(static)
 #endif

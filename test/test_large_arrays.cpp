@@ -1,0 +1,195 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
+ */
+
+// detail::adviseHugePages() and the vector helpers built on it: the advice covers
+// exactly the whole 2 MB pages inside an array of at least kHugePageAdviceBytes, and
+// nothing else; the helpers size and fill the vectors as reserve/resize/assign do.
+// The advice is read back from the kernel (/proc/self/smaps: "hg" among a mapping's
+// VmFlags), on Linux with transparent huge pages; elsewhere those tests are skipped.
+
+#include <pcl_selective_seg/impl/large_arrays.hpp>
+
+#include <gtest/gtest.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
+
+namespace detail = pcl::selective_seg::detail;
+
+namespace {
+
+constexpr std::uintptr_t kHugePage = std::uintptr_t{2} << 20;
+
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+
+/** Whether the mapping holding \a address carries the huge-page advice, from
+ * /proc/self/smaps; false if no mapping holds it. */
+bool
+advised(std::uintptr_t address)
+{
+  std::ifstream smaps("/proc/self/smaps");
+  std::string line;
+  bool inside = false;
+  while (std::getline(smaps, line)) {
+    std::uintptr_t begin = 0, end = 0;
+    char dash = 0;
+    std::istringstream head(line);
+    if (head >> std::hex >> begin >> dash >> end && dash == '-') {
+      inside = begin <= address && address < end;
+      continue;
+    }
+    if (inside && line.rfind("VmFlags:", 0) == 0)
+      return (line + " ").find(" hg ") != std::string::npos;
+  }
+  return false;
+}
+
+/** An anonymous private mapping of \a bytes, unmapped at the end of the scope. */
+class Mapping {
+public:
+  explicit Mapping(std::size_t bytes)
+      : bytes_(bytes)
+  {
+    void* p = mmap(
+        nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    data_ = p == MAP_FAILED ? nullptr : static_cast<char*>(p);
+  }
+  ~Mapping()
+  {
+    if (data_)
+      munmap(data_, bytes_);
+  }
+  Mapping(const Mapping&) = delete;
+  Mapping& operator=(const Mapping&) = delete;
+  char* data() const { return data_; }
+
+private:
+  std::size_t bytes_;
+  char* data_ = nullptr;
+};
+
+/** Skips the calling test where the kernel takes no huge-page advice. */
+#define SKIP_WITHOUT_HUGE_PAGE_ADVICE()                                                \
+  do {                                                                                 \
+    Mapping probe(4 * kHugePage);                                                      \
+    ASSERT_NE(probe.data(), nullptr);                                                  \
+    const auto first =                                                                 \
+        (reinterpret_cast<std::uintptr_t>(probe.data()) + kHugePage - 1) &             \
+        ~(kHugePage - 1);                                                              \
+    if (madvise(reinterpret_cast<void*>(first), kHugePage, MADV_HUGEPAGE) != 0 ||      \
+        !advised(first))                                                               \
+      GTEST_SKIP() << "this kernel takes no MADV_HUGEPAGE advice";                     \
+  } while (false)
+
+TEST(AdviseHugePages, CoversExactlyTheWholeHugePagesInsideTheArray)
+{
+  SKIP_WITHOUT_HUGE_PAGE_ADVICE();
+  // An array starting 1 MB + 12 bytes past a 2 MB boundary, ending 3 bytes short of
+  // one: its whole huge pages run from the next boundary to the last one inside it.
+  const std::size_t bytes = detail::kHugePageAdviceBytes + kHugePage + 1000;
+  Mapping mapping(bytes + 4 * kHugePage);
+  ASSERT_NE(mapping.data(), nullptr);
+  const auto base = (reinterpret_cast<std::uintptr_t>(mapping.data()) + kHugePage - 1) &
+                    ~(kHugePage - 1);
+  const std::uintptr_t begin = base + kHugePage / 2 + 12;
+  const std::uintptr_t end = begin + bytes;
+  const std::uintptr_t first = base + kHugePage;
+  const std::uintptr_t last = end & ~(kHugePage - 1);
+  ASSERT_LT(first, last);
+  detail::adviseHugePages(reinterpret_cast<const void*>(begin), bytes);
+  EXPECT_TRUE(advised(first));
+  EXPECT_TRUE(advised(last - 1));
+  EXPECT_TRUE(advised((first + last) / 2));
+  EXPECT_FALSE(advised(first - 1)) << "the partial page at the array's start";
+  EXPECT_FALSE(advised(begin)) << "the partial page at the array's start";
+  EXPECT_FALSE(advised(last)) << "the partial page at the array's end";
+  EXPECT_FALSE(advised(end - 1)) << "the partial page at the array's end";
+}
+
+TEST(AdviseHugePages, LeavesSmallerArraysAlone)
+{
+  SKIP_WITHOUT_HUGE_PAGE_ADVICE();
+  Mapping mapping(detail::kHugePageAdviceBytes + 2 * kHugePage);
+  ASSERT_NE(mapping.data(), nullptr);
+  const auto first =
+      (reinterpret_cast<std::uintptr_t>(mapping.data()) + kHugePage - 1) &
+      ~(kHugePage - 1);
+  // Several whole huge pages, but one byte short of the threshold.
+  detail::adviseHugePages(reinterpret_cast<const void*>(first),
+                          detail::kHugePageAdviceBytes - 1);
+  EXPECT_FALSE(advised(first));
+  EXPECT_FALSE(advised(first + detail::kHugePageAdviceBytes / 2));
+}
+
+TEST(LargeVectors, NewStorageOfALargeVectorIsAdvised)
+{
+  SKIP_WITHOUT_HUGE_PAGE_ADVICE();
+  std::vector<std::uint32_t> v;
+  const std::size_t n = (detail::kHugePageAdviceBytes + 3 * kHugePage) / sizeof(v[0]);
+  detail::resizeLarge(v, n);
+  const auto data = reinterpret_cast<std::uintptr_t>(v.data());
+  const std::uintptr_t first = (data + kHugePage - 1) & ~(kHugePage - 1);
+  EXPECT_TRUE(advised(first));
+  EXPECT_TRUE(advised(first + detail::kHugePageAdviceBytes));
+}
+
+#endif // __linux__ && MADV_HUGEPAGE
+
+} // namespace
+
+TEST(LargeVectors, SizeAndValuesAreThoseOfTheStandardCalls)
+{
+  // Below and above the threshold; from empty and from a vector with elements.
+  for (const std::size_t n : {std::size_t{0},
+                              std::size_t{5},
+                              detail::kHugePageAdviceBytes / sizeof(int) + 77}) {
+    std::vector<int> resized{1, 2, 3};
+    detail::resizeLarge(resized, n);
+    std::vector<int> expected{1, 2, 3};
+    expected.resize(n);
+    EXPECT_EQ(resized, expected);
+
+    std::vector<int> assigned{4, 5};
+    detail::assignLarge(assigned, n, -7);
+    EXPECT_EQ(assigned, std::vector<int>(n, -7));
+
+    std::vector<int> reserved{8, 9};
+    detail::reserveLarge(reserved, n);
+    EXPECT_GE(reserved.capacity(), n);
+    EXPECT_EQ(reserved, (std::vector<int>{8, 9}));
+  }
+}
+
+TEST(LargeVectors, StorageLargeEnoughIsKept)
+{
+  std::vector<double> v(1000, 1.5);
+  v.reserve(5000);
+  const double* const data = v.data();
+  detail::reserveLarge(v, 4000);
+  EXPECT_EQ(v.data(), data);
+  detail::resizeLarge(v, 3000);
+  EXPECT_EQ(v.data(), data);
+  EXPECT_EQ(v.size(), 3000u);
+  EXPECT_EQ(v[999], 1.5);
+  EXPECT_EQ(v[1000], 0.0);
+}
+
+TEST(AdviseHugePages, NullOrEmptyIsANoOp)
+{
+  detail::adviseHugePages(nullptr, detail::kHugePageAdviceBytes * 2);
+  int x = 0;
+  detail::adviseHugePages(&x, 0);
+  detail::adviseHugePages(&x, sizeof x);
+  EXPECT_EQ(x, 0);
+}
