@@ -12,6 +12,7 @@
 // unwritable output), 2 = usage error (unknown option, bad value). Outputs are written
 // under temporary names and renamed only when all succeeded.
 
+#include <pcl_selective_seg/parameters.h>
 #include <pcl_selective_seg/regions_of_interest.h>
 #include <pcl_selective_seg/selective_segmentation.h>
 
@@ -497,8 +498,12 @@ run(int argc, char** argv)
 int
 main(int argc, char** argv)
 {
-  // One pipeline a process: freed arrays are kept for the next stage's (same peak).
-  selseg_apps::keepFreedMemory();
+  // One pipeline a process: freed arrays are kept for the next stage's (same peak),
+  // and, none being returned to the system, every page is faulted in once: huge pages
+  // for the arrays from 4 MB on (1M points: 0.91-0.99 s instead of 1.34-1.49 s, the
+  // same peak; docs/performance.md, "Huge pages").
+  if (selseg_apps::keepFreedMemory())
+    pcl::selective_seg::setHugePageAdviceThreshold(std::size_t{4} << 20);
   // Out of memory outside the library's own handling (the options, reading, the
   // outputs): a message, and the outputs' temporaries removed on the way out of
   // segment().

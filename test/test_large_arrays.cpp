@@ -5,18 +5,21 @@
  */
 
 // detail::adviseHugePages() and the vector helpers built on it: the advice covers
-// exactly the whole 2 MB pages inside an array of at least kHugePageAdviceBytes, and
-// nothing else; the helpers size and fill the vectors as reserve/resize/assign do.
-// The advice is read back from the kernel (/proc/self/smaps: "hg" among a mapping's
-// VmFlags), on Linux with transparent huge pages; elsewhere those tests are skipped.
+// exactly the whole 2 MB pages inside an array of at least the threshold
+// (setHugePageAdviceThreshold(), 32 MB by default), and nothing else; the helpers size
+// and fill the vectors as reserve/resize/assign do. The advice is read back from the
+// kernel (/proc/self/smaps: "hg" among a mapping's VmFlags), on Linux with transparent
+// huge pages; elsewhere those tests are skipped.
 
 #include <pcl_selective_seg/impl/large_arrays.hpp>
+#include <pcl_selective_seg/parameters.h>
 
 #include <gtest/gtest.h>
 
 #include <cstddef>
 #include <cstdint>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -25,6 +28,7 @@
 #include <sys/mman.h>
 #endif
 
+namespace seg = pcl::selective_seg;
 namespace detail = pcl::selective_seg::detail;
 
 namespace {
@@ -97,7 +101,7 @@ TEST(AdviseHugePages, CoversExactlyTheWholeHugePagesInsideTheArray)
   SKIP_WITHOUT_HUGE_PAGE_ADVICE();
   // An array starting 1 MB + 12 bytes past a 2 MB boundary, ending 3 bytes short of
   // one: its whole huge pages run from the next boundary to the last one inside it.
-  const std::size_t bytes = detail::kHugePageAdviceBytes + kHugePage + 1000;
+  const std::size_t bytes = seg::kDefaultHugePageAdviceBytes + kHugePage + 1000;
   Mapping mapping(bytes + 4 * kHugePage);
   ASSERT_NE(mapping.data(), nullptr);
   const auto base = (reinterpret_cast<std::uintptr_t>(mapping.data()) + kHugePage - 1) &
@@ -120,28 +124,70 @@ TEST(AdviseHugePages, CoversExactlyTheWholeHugePagesInsideTheArray)
 TEST(AdviseHugePages, LeavesSmallerArraysAlone)
 {
   SKIP_WITHOUT_HUGE_PAGE_ADVICE();
-  Mapping mapping(detail::kHugePageAdviceBytes + 2 * kHugePage);
+  Mapping mapping(seg::kDefaultHugePageAdviceBytes + 2 * kHugePage);
   ASSERT_NE(mapping.data(), nullptr);
   const auto first =
       (reinterpret_cast<std::uintptr_t>(mapping.data()) + kHugePage - 1) &
       ~(kHugePage - 1);
   // Several whole huge pages, but one byte short of the threshold.
   detail::adviseHugePages(reinterpret_cast<const void*>(first),
-                          detail::kHugePageAdviceBytes - 1);
+                          seg::kDefaultHugePageAdviceBytes - 1);
   EXPECT_FALSE(advised(first));
-  EXPECT_FALSE(advised(first + detail::kHugePageAdviceBytes / 2));
+  EXPECT_FALSE(advised(first + seg::kDefaultHugePageAdviceBytes / 2));
+}
+
+/** Sets the advice threshold for the scope of a test, then restores it. */
+class ScopedThreshold {
+public:
+  explicit ScopedThreshold(std::size_t bytes)
+      : saved_(seg::getHugePageAdviceThreshold())
+  {
+    seg::setHugePageAdviceThreshold(bytes);
+  }
+  ~ScopedThreshold() { seg::setHugePageAdviceThreshold(saved_); }
+  ScopedThreshold(const ScopedThreshold&) = delete;
+  ScopedThreshold& operator=(const ScopedThreshold&) = delete;
+
+private:
+  std::size_t saved_;
+};
+
+TEST(AdviseHugePages, FollowsTheThresholdSet)
+{
+  SKIP_WITHOUT_HUGE_PAGE_ADVICE();
+  const std::size_t bytes = 3 * kHugePage;
+  Mapping mapping(bytes + 4 * kHugePage);
+  ASSERT_NE(mapping.data(), nullptr);
+  const auto first =
+      (reinterpret_cast<std::uintptr_t>(mapping.data()) + kHugePage - 1) &
+      ~(kHugePage - 1);
+  const auto* array = reinterpret_cast<const void*>(first);
+  {
+    ScopedThreshold off(std::numeric_limits<std::size_t>::max());
+    detail::adviseHugePages(array, bytes);
+    EXPECT_FALSE(advised(first)) << "advice off";
+  }
+  detail::adviseHugePages(array, bytes);
+  EXPECT_FALSE(advised(first)) << "6 MB, under the default threshold";
+  {
+    ScopedThreshold low(bytes);
+    detail::adviseHugePages(array, bytes);
+    EXPECT_TRUE(advised(first));
+    EXPECT_TRUE(advised(first + bytes - 1));
+  }
 }
 
 TEST(LargeVectors, NewStorageOfALargeVectorIsAdvised)
 {
   SKIP_WITHOUT_HUGE_PAGE_ADVICE();
   std::vector<std::uint32_t> v;
-  const std::size_t n = (detail::kHugePageAdviceBytes + 3 * kHugePage) / sizeof(v[0]);
+  const std::size_t n =
+      (seg::kDefaultHugePageAdviceBytes + 3 * kHugePage) / sizeof(v[0]);
   detail::resizeLarge(v, n);
   const auto data = reinterpret_cast<std::uintptr_t>(v.data());
   const std::uintptr_t first = (data + kHugePage - 1) & ~(kHugePage - 1);
   EXPECT_TRUE(advised(first));
-  EXPECT_TRUE(advised(first + detail::kHugePageAdviceBytes));
+  EXPECT_TRUE(advised(first + seg::kDefaultHugePageAdviceBytes));
 }
 
 #endif // __linux__ && MADV_HUGEPAGE
@@ -153,7 +199,7 @@ TEST(LargeVectors, SizeAndValuesAreThoseOfTheStandardCalls)
   // Below and above the threshold; from empty and from a vector with elements.
   for (const std::size_t n : {std::size_t{0},
                               std::size_t{5},
-                              detail::kHugePageAdviceBytes / sizeof(int) + 77}) {
+                              seg::kDefaultHugePageAdviceBytes / sizeof(int) + 77}) {
     std::vector<int> resized{1, 2, 3};
     detail::resizeLarge(resized, n);
     std::vector<int> expected{1, 2, 3};
@@ -185,9 +231,19 @@ TEST(LargeVectors, StorageLargeEnoughIsKept)
   EXPECT_EQ(v[1000], 0.0);
 }
 
+TEST(HugePageAdviceThreshold, DefaultIsThirtyTwoMegabytesAndSetValuesAreKept)
+{
+  EXPECT_EQ(seg::kDefaultHugePageAdviceBytes, std::size_t{32} << 20);
+  EXPECT_EQ(seg::getHugePageAdviceThreshold(), seg::kDefaultHugePageAdviceBytes);
+  seg::setHugePageAdviceThreshold(std::size_t{4} << 20);
+  EXPECT_EQ(seg::getHugePageAdviceThreshold(), std::size_t{4} << 20);
+  seg::setHugePageAdviceThreshold(seg::kDefaultHugePageAdviceBytes);
+  EXPECT_EQ(seg::getHugePageAdviceThreshold(), seg::kDefaultHugePageAdviceBytes);
+}
+
 TEST(AdviseHugePages, NullOrEmptyIsANoOp)
 {
-  detail::adviseHugePages(nullptr, detail::kHugePageAdviceBytes * 2);
+  detail::adviseHugePages(nullptr, seg::kDefaultHugePageAdviceBytes * 2);
   int x = 0;
   detail::adviseHugePages(&x, 0);
   detail::adviseHugePages(&x, sizeof x);

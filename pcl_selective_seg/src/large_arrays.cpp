@@ -5,7 +5,9 @@
  */
 
 #include <pcl_selective_seg/impl/large_arrays.hpp>
+#include <pcl_selective_seg/parameters.h>
 
+#include <atomic>
 #include <cstdint>
 
 #if defined(__linux__)
@@ -14,13 +16,30 @@
 
 namespace pcl {
 namespace selective_seg {
+
+namespace {
+std::atomic<std::size_t> huge_page_advice_bytes{kDefaultHugePageAdviceBytes};
+} // namespace
+
+void
+setHugePageAdviceThreshold(std::size_t bytes) noexcept
+{
+  huge_page_advice_bytes.store(bytes, std::memory_order_relaxed);
+}
+
+std::size_t
+getHugePageAdviceThreshold() noexcept
+{
+  return huge_page_advice_bytes.load(std::memory_order_relaxed);
+}
+
 namespace detail {
 
 void
 adviseHugePages(const void* data, std::size_t bytes) noexcept
 {
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
-  if (!data || bytes < kHugePageAdviceBytes)
+  if (!data || bytes < getHugePageAdviceThreshold())
     return;
   constexpr std::uintptr_t huge_page = std::uintptr_t{2} << 20;
   const auto begin = reinterpret_cast<std::uintptr_t>(data);
@@ -36,5 +55,6 @@ adviseHugePages(const void* data, std::size_t bytes) noexcept
 }
 
 } // namespace detail
+
 } // namespace selective_seg
 } // namespace pcl

@@ -15,18 +15,10 @@ namespace pcl {
 namespace selective_seg {
 namespace detail {
 
-/** \brief Arrays of at least this many bytes are advised to the kernel as huge-page
- * memory (adviseHugePages()): glibc's largest mapping threshold on 64-bit systems
- * (DEFAULT_MMAP_THRESHOLD_MAX). With glibc's default settings a block this large is
- * always mapped afresh and unmapped when freed, so every run faults its pages in
- * again; smaller blocks are reused from the heap, where the advice measured 4-8%
- * slower at 1M points (docs/performance.md, "Huge pages"). */
-constexpr std::size_t kHugePageAdviceBytes = std::size_t{32} << 20;
-
 /** \brief Asks the kernel to back the whole 2 MB pages inside [data, data + bytes)
  * with transparent huge pages (Linux `madvise(MADV_HUGEPAGE)`), when \a bytes is at
- * least kHugePageAdviceBytes; otherwise, or on other systems, or where the kernel
- * refuses, nothing happens.
+ * least getHugePageAdviceThreshold() (32 MB unless set); otherwise, or on other
+ * systems, or where the kernel refuses, nothing happens.
  *
  * Called on a new array before it is first written. Memory a large array takes from the
  * system is otherwise mapped in 4 KB pages, one page fault each on first touch; on
