@@ -19,13 +19,14 @@
 // Euler's count over the whole mesh) before it replaces the input.
 
 #include <pcl_selective_seg/delaunay_2d_update.h>
+#include <pcl_selective_seg/impl/large_arrays.hpp>
 #include <pcl_selective_seg/impl/radix_sort.hpp>
-
-#include "delaunay_2d_backends.h"
 
 #include <algorithm>
 #include <cstdint>
 #include <unordered_map>
+
+#include "delaunay_2d_backends.h"
 
 namespace pcl {
 namespace selective_seg {
@@ -305,9 +306,9 @@ Inserter::run(const std::vector<QuantizedPoint>& q,
   }
 
   // 2. The new numbering: the union in lexicographic order.
-  info.old_to_new_point.resize(p_.size());
+  detail::resizeLarge(info.old_to_new_point, p_.size());
   info.inserted_points.resize(q.size());
-  out_points.resize(p_.size() + q.size());
+  detail::resizeLarge(out_points, p_.size() + q.size());
   mergeInChunks(
       p_.size(),
       q.size(),
@@ -424,8 +425,8 @@ Inserter::run(const std::vector<QuantizedPoint>& q,
     }
   const std::size_t num_kept = num_old - conflicts_.size();
   const std::size_t total = num_kept + fresh.size();
-  out_triangles.resize(total);
-  info.old_to_new_triangle.resize(num_old);
+  detail::resizeLarge(out_triangles, total);
+  detail::resizeLarge(info.old_to_new_triangle, num_old);
   info.new_triangles.resize(fresh.size());
   std::vector<pcl::index_t> local_to_new(local_tris.size(), -1);
   std::sort(conflicts_.begin(), conflicts_.end());
@@ -489,7 +490,7 @@ Inserter::run(const std::vector<QuantizedPoint>& q,
                             "meet the kept triangles");
     return false;
   }
-  out_neighbours.assign(total, Triangle{-1, -1, -1});
+  detail::assignLarge(out_neighbours, total, Triangle{-1, -1, -1});
   std::size_t hull_edges = 0;
   const auto n_old = static_cast<std::ptrdiff_t>(num_old);
 #ifdef _OPENMP
@@ -588,10 +589,10 @@ insertDelaunayPoints(std::vector<QuantizedPoint>& points,
     }
   }
   if (new_points.empty()) {
-    info.old_to_new_point.resize(points.size());
+    detail::resizeLarge(info.old_to_new_point, points.size());
     for (std::size_t i = 0; i < points.size(); ++i)
       info.old_to_new_point[i] = static_cast<pcl::index_t>(i);
-    info.old_to_new_triangle.resize(triangles.size());
+    detail::resizeLarge(info.old_to_new_triangle, triangles.size());
     for (std::size_t i = 0; i < triangles.size(); ++i)
       info.old_to_new_triangle[i] = static_cast<pcl::index_t>(i);
     return true;

@@ -66,7 +66,7 @@ SelectiveSegmentation<PointT>::updateUnion(const PointCloud& new_points,
   update_stats_.new_points = new_points.size();
   const std::size_t first_new = input_->size();
   auto merged = pcl::make_shared<PointCloud>();
-  merged->reserve(first_new + new_points.size());
+  detail::reserveLarge(merged->points, first_new + new_points.size());
   merged->points.insert(merged->end(), input_->begin(), input_->end());
   merged->points.insert(merged->end(), new_points.begin(), new_points.end());
   merged->width = static_cast<std::uint32_t>(merged->points.size());

@@ -115,8 +115,10 @@ SphericalDelaunay<PointT>::insertPoints(std::size_t first_new_point,
 
   // Renumber the vertex arrays and the point map.
   const std::size_t num_vertices = tri.vertex_angles.size();
-  pcl::Indices vertex_point(num_vertices);
-  std::vector<Eigen::Vector3f> positions(num_vertices);
+  pcl::Indices vertex_point;
+  detail::resizeLarge(vertex_point, num_vertices);
+  std::vector<Eigen::Vector3f> positions;
+  detail::resizeLarge(positions, num_vertices);
   const auto num_old = static_cast<std::ptrdiff_t>(tri.vertex_point.size());
 #ifdef _OPENMP
 #pragma omp parallel for num_threads(num_threads_) schedule(static) \
@@ -139,7 +141,8 @@ SphericalDelaunay<PointT>::insertPoints(std::size_t first_new_point,
       positions[v] = toSensorFrame(pose, best).template cast<float>();
       moved_vertices.push_back(v);
     }
-  std::vector<pcl::index_t> point_vertex(cloud.size(), kOutsideIndices);
+  std::vector<pcl::index_t> point_vertex;
+  detail::assignLarge(point_vertex, cloud.size(), kOutsideIndices);
   const auto num_old_points = static_cast<std::ptrdiff_t>(first_new_point);
 #ifdef _OPENMP
 #pragma omp parallel for num_threads(num_threads_) schedule(static) \
