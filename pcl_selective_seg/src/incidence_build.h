@@ -81,7 +81,7 @@ placeInBuckets(std::size_t num_items,
   // chunk's first one goes.
   std::vector<std::vector<std::size_t>> cursors(chunks);
   for (auto& cursor : cursors)
-    assignLarge(cursor, num_groups, std::size_t{0});
+    assignLarge(cursor, num_groups, 0);
 #ifdef _OPENMP
 #pragma omp parallel for num_threads(static_cast<int>(chunks)) schedule(static, 1)
 #endif

@@ -205,8 +205,7 @@ computeTriangleNormals(const Vector3fVector& positions,
                        int num_threads)
 {
   const float nan = std::numeric_limits<float>::quiet_NaN();
-  detail::assignLarge(
-      normals, triangles.size(), Eigen::Vector3f(Eigen::Vector3f::Constant(nan)));
+  detail::assignLarge(normals, triangles.size(), Eigen::Vector3f::Constant(nan));
   detail::assignLarge(areas, triangles.size(), 0.0);
   const Eigen::Vector3d eye = viewpoint.cast<double>();
   const auto n_tri = static_cast<std::ptrdiff_t>(triangles.size());
@@ -444,13 +443,13 @@ scatterVertexNormals(std::size_t num_vertices,
     if (run_lowest[c] < run_lowest[c - 1])
       return false;
   std::vector<Eigen::Vector3d> sums;
-  detail::assignLarge(sums, num_vertices, Eigen::Vector3d(Eigen::Vector3d::Zero()));
+  detail::assignLarge(sums, num_vertices, Eigen::Vector3d::Zero());
   detail::assignLarge(vertex_areas, num_vertices, 0.0);
   std::vector<std::vector<std::pair<pcl::index_t, pcl::index_t>>> deferred(runs);
   // With several runs, the corners each vertex gets directly; with its deferred corners
   // they tell whether the walk around a deferred vertex finds all its triangles.
   std::vector<pcl::index_t> corners;
-  detail::assignLarge(corners, runs > 1 ? num_vertices : 0, pcl::index_t{0});
+  detail::assignLarge(corners, runs > 1 ? num_vertices : 0, 0);
   pcl::index_t* const direct = runs > 1 ? corners.data() : nullptr;
   std::vector<char> out_of_order(runs, 0);
   detail::ParallelExceptions errors;
@@ -791,7 +790,7 @@ markEdgeOnTriangles(const Vector3fVector& positions,
                     std::vector<std::uint8_t>& edge_on,
                     int num_threads)
 {
-  detail::assignLarge(edge_on, triangles.size(), std::uint8_t{0});
+  detail::assignLarge(edge_on, triangles.size(), 0);
   const double min_cos = minIncidenceCos(max_incidence);
   const Eigen::Vector3d eye = viewpoint.cast<double>();
   const auto n_tri = static_cast<std::ptrdiff_t>(triangles.size());

@@ -787,7 +787,7 @@ classifyTriangles(const std::vector<Triangle>& triangles,
                   int num_threads)
 {
   const double cos_edge = std::cos(max_edge_triangle_angle);
-  detail::assignLarge(labels, triangles.size(), std::uint32_t{0});
+  detail::assignLarge(labels, triangles.size(), 0);
   detail::assignLarge(classes, triangles.size(), TriangleClass::InvalidEdge);
   const int threads = detail::threadCount(num_threads);
   const auto num_triangles = static_cast<std::ptrdiff_t>(triangles.size());

@@ -353,7 +353,7 @@ SelectiveSegmentation<PointT>::buildOctree()
                 "the octree holds no point: no point has a normal, or the octree "
                 "refused the points' extent (reason above)");
 
-  detail::assignLarge(vertex_leaf_, num_vertices, pcl::index_t{-1});
+  detail::assignLarge(vertex_leaf_, num_vertices, -1);
   const auto& leaves = octree_->getAdaptiveLeaves();
   const auto& ordered = octree_->getOrderedIndices();
   // Each vertex is in one leaf at most: the leaves can be split among the threads.
