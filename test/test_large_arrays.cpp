@@ -37,6 +37,13 @@ constexpr std::uintptr_t kHugePage = std::uintptr_t{2} << 20;
 
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
 
+/** The first 2 MB boundary at or after \a p. */
+std::uintptr_t
+firstHugePage(const void* p)
+{
+  return (reinterpret_cast<std::uintptr_t>(p) + kHugePage - 1) & ~(kHugePage - 1);
+}
+
 /** Whether the mapping holding \a address carries the huge-page advice, from
  * /proc/self/smaps; false if no mapping holds it. */
 bool
@@ -88,9 +95,7 @@ private:
   do {                                                                                 \
     Mapping probe(4 * kHugePage);                                                      \
     ASSERT_NE(probe.data(), nullptr);                                                  \
-    const auto first =                                                                 \
-        (reinterpret_cast<std::uintptr_t>(probe.data()) + kHugePage - 1) &             \
-        ~(kHugePage - 1);                                                              \
+    const std::uintptr_t first = firstHugePage(probe.data());                          \
     if (madvise(reinterpret_cast<void*>(first), kHugePage, MADV_HUGEPAGE) != 0 ||      \
         !advised(first))                                                               \
       GTEST_SKIP() << "this kernel takes no MADV_HUGEPAGE advice";                     \
@@ -104,8 +109,7 @@ TEST(AdviseHugePages, CoversExactlyTheWholeHugePagesInsideTheArray)
   const std::size_t bytes = seg::kDefaultHugePageAdviceBytes + kHugePage + 1000;
   Mapping mapping(bytes + 4 * kHugePage);
   ASSERT_NE(mapping.data(), nullptr);
-  const auto base = (reinterpret_cast<std::uintptr_t>(mapping.data()) + kHugePage - 1) &
-                    ~(kHugePage - 1);
+  const std::uintptr_t base = firstHugePage(mapping.data());
   const std::uintptr_t begin = base + kHugePage / 2 + 12;
   const std::uintptr_t end = begin + bytes;
   const std::uintptr_t first = base + kHugePage;
@@ -126,9 +130,7 @@ TEST(AdviseHugePages, LeavesSmallerArraysAlone)
   SKIP_WITHOUT_HUGE_PAGE_ADVICE();
   Mapping mapping(seg::kDefaultHugePageAdviceBytes + 2 * kHugePage);
   ASSERT_NE(mapping.data(), nullptr);
-  const auto first =
-      (reinterpret_cast<std::uintptr_t>(mapping.data()) + kHugePage - 1) &
-      ~(kHugePage - 1);
+  const std::uintptr_t first = firstHugePage(mapping.data());
   // Several whole huge pages, but one byte short of the threshold.
   detail::adviseHugePages(reinterpret_cast<const void*>(first),
                           seg::kDefaultHugePageAdviceBytes - 1);
@@ -158,9 +160,7 @@ TEST(AdviseHugePages, FollowsTheThresholdSet)
   const std::size_t bytes = 3 * kHugePage;
   Mapping mapping(bytes + 4 * kHugePage);
   ASSERT_NE(mapping.data(), nullptr);
-  const auto first =
-      (reinterpret_cast<std::uintptr_t>(mapping.data()) + kHugePage - 1) &
-      ~(kHugePage - 1);
+  const std::uintptr_t first = firstHugePage(mapping.data());
   const auto* array = reinterpret_cast<const void*>(first);
   {
     ScopedThreshold off(std::numeric_limits<std::size_t>::max());
@@ -184,8 +184,7 @@ TEST(LargeVectors, NewStorageOfALargeVectorIsAdvised)
   const std::size_t n =
       (seg::kDefaultHugePageAdviceBytes + 3 * kHugePage) / sizeof(v[0]);
   detail::resizeLarge(v, n);
-  const auto data = reinterpret_cast<std::uintptr_t>(v.data());
-  const std::uintptr_t first = (data + kHugePage - 1) & ~(kHugePage - 1);
+  const std::uintptr_t first = firstHugePage(v.data());
   EXPECT_TRUE(advised(first));
   EXPECT_TRUE(advised(first + seg::kDefaultHugePageAdviceBytes));
 }
