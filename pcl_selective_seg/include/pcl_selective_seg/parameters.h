@@ -27,7 +27,7 @@ PCL_EXPORTS unsigned int defaultThreads();
  * threshold on 64-bit systems (DEFAULT_MMAP_THRESHOLD_MAX). With glibc's default
  * settings a block this large is mapped afresh and unmapped when freed, so every run
  * faults its pages in again; smaller blocks are reused from the heap, where the advice
- * measured 4-8% slower at 1M points (docs/performance.md, "Huge pages"). */
+ * measured up to 12-14% slower at 1M points (docs/performance.md, "Huge pages"). */
 constexpr std::size_t kDefaultHugePageAdviceBytes = std::size_t{32} << 20;
 
 /** \brief Process-wide: the pipeline's arrays of at least \a bytes are advised to the
