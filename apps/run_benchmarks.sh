@@ -9,6 +9,17 @@ set -euo pipefail
 build=${1:?usage: $0 BUILD_DIR [SHARED_DATA_DIR]}
 shared=${2:-$(dirname "$0")/../../shared/data}
 repo=$(cd "$(dirname "$0")/.." && pwd)
+if [ ! -x "$build/test/selseg_benchmark" ]; then
+  echo "$0: no $build/test/selseg_benchmark: give the build folder of a built checkout" >&2
+  exit 2
+fi
+# The report needs python3 and gnuplot: checked before the suite (minutes), not after it.
+for tool in python3 gnuplot; do
+  if ! command -v "$tool" > /dev/null; then
+    echo "$0: $tool not found: install it (apt-get install ${tool/gnuplot/gnuplot-nox})" >&2
+    exit 2
+  fi
+done
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
