@@ -23,11 +23,26 @@ done
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
+# Spell probe: the 46k pipeline alone on one thread, then on two, just before and just
+# after the suite. On a virtual machine the two vCPUs sometimes get one core's
+# throughput between them (a slow spell), and then two threads are hardly faster than
+# one: the report says which spell the run began and ended in.
+probe() {
+  local threads
+  for threads in 1 2; do
+    OMP_NUM_THREADS=$threads "$build/test/selseg_benchmark" \
+      --benchmark_filter='^BM_Pipeline_Door/46255/' \
+      --benchmark_out="$work/probe_$1_$threads.json" --benchmark_out_format=json > /dev/null
+  done
+}
+
+probe before
 load_before=$(cut -d' ' -f1-3 /proc/loadavg)
 SELSEG_DATA="$shared" "$build/test/selseg_benchmark" \
   --benchmark_enable_random_interleaving=true \
   --benchmark_out="$work/benchmark.json" --benchmark_out_format=json
 load_after=$(cut -d' ' -f1-3 /proc/loadavg)
+probe after
 # SELSEG_BENCHMARK_JSON=FILE keeps a copy of the raw results.
 if [ -n "${SELSEG_BENCHMARK_JSON:-}" ]; then cp "$work/benchmark.json" "$SELSEG_BENCHMARK_JSON"; fi
 
@@ -40,4 +55,6 @@ done
 python3 "$repo/apps/perf_report.py" --benchmark "$work/benchmark.json" \
   --tool "$build/apps/pcl_selective_seg" --scans "$work" \
   --markdown "$repo/docs/performance.md" --plot "$repo/docs/images/performance_scaling.png" \
-  --load "$load_before" "$load_after"
+  --load "$load_before" "$load_after" \
+  --probe "$work/probe_before_1.json" "$work/probe_before_2.json" \
+  "$work/probe_after_1.json" "$work/probe_after_2.json"
