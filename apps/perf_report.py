@@ -83,10 +83,13 @@ def load_note(load):
     """A sentence on the machine's load around the benchmark run."""
     if not load:
         return ""
-    busy = max(float(load[0].split()[0]), float(load[1].split()[0])) > 1.0
+    # The suite's own two threads raise the load after it to about 1; only the load
+    # before it tells whether other work was running.
+    busy = float(load[0].split()[0]) > 0.7
     return (f" Load average (1, 5, 15 min) {load[0]} before the suite, {load[1]} after"
-            + (": other work shared the cores during the run, so the timings (both"
-               " columns) are pessimistic." if busy else "."))
+            " it (the suite's own threads included)"
+            + (": other work was running on the cores when the suite began, so the"
+               " timings (both columns) may be pessimistic." if busy else "."))
 
 
 def probe_note(paths):

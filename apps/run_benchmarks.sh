@@ -36,8 +36,8 @@ probe() {
   done
 }
 
-probe before
 load_before=$(cut -d' ' -f1-3 /proc/loadavg)
+probe before
 SELSEG_DATA="$shared" "$build/test/selseg_benchmark" \
   --benchmark_enable_random_interleaving=true \
   --benchmark_out="$work/benchmark.json" --benchmark_out_format=json
