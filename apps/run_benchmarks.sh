@@ -9,11 +9,15 @@ set -euo pipefail
 build=${1:?usage: $0 BUILD_DIR [SHARED_DATA_DIR]}
 shared=${2:-$(dirname "$0")/../../shared/data}
 repo=$(cd "$(dirname "$0")/.." && pwd)
-if [ ! -x "$build/test/selseg_benchmark" ]; then
-  echo "$0: no $build/test/selseg_benchmark: give the build folder of a built checkout" >&2
-  exit 2
-fi
-# The report needs python3 and gnuplot: checked before the suite (minutes), not after it.
+# The suite, then the simulator and the tool for the peak memory: all checked before
+# the suite (minutes), not after it.
+for exe in test/selseg_benchmark apps/pcl_selective_seg_simulate apps/pcl_selective_seg; do
+  if [ ! -x "$build/$exe" ]; then
+    echo "$0: no $build/$exe: give the build folder of a built checkout" >&2
+    exit 2
+  fi
+done
+# The report needs python3 and gnuplot, checked likewise.
 for tool in python3 gnuplot; do
   if ! command -v "$tool" > /dev/null; then
     echo "$0: $tool not found: install it (apt-get install ${tool/gnuplot/gnuplot-nox})" >&2
