@@ -24,6 +24,8 @@
 #include <string>
 #include <vector>
 
+#include "huge_page_advice.h"
+
 #if defined(__linux__)
 #include <sys/mman.h>
 #endif
@@ -33,73 +35,12 @@ namespace detail = pcl::selective_seg::detail;
 
 namespace {
 
-constexpr std::uintptr_t kHugePage = std::uintptr_t{2} << 20;
+#if defined(SELSEG_TEST_HUGE_PAGE_ADVICE)
 
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
-
-/** The first 2 MB boundary at or after \a p. */
-std::uintptr_t
-firstHugePage(const void* p)
-{
-  return (reinterpret_cast<std::uintptr_t>(p) + kHugePage - 1) & ~(kHugePage - 1);
-}
-
-/** Whether the mapping holding \a address carries the huge-page advice, from
- * /proc/self/smaps; false if no mapping holds it. */
-bool
-advised(std::uintptr_t address)
-{
-  std::ifstream smaps("/proc/self/smaps");
-  std::string line;
-  bool inside = false;
-  while (std::getline(smaps, line)) {
-    std::uintptr_t begin = 0, end = 0;
-    char dash = 0;
-    std::istringstream head(line);
-    if (head >> std::hex >> begin >> dash >> end && dash == '-') {
-      inside = begin <= address && address < end;
-      continue;
-    }
-    if (inside && line.rfind("VmFlags:", 0) == 0)
-      return (line + " ").find(" hg ") != std::string::npos;
-  }
-  return false;
-}
-
-/** An anonymous private mapping of \a bytes, unmapped at the end of the scope. */
-class Mapping {
-public:
-  explicit Mapping(std::size_t bytes)
-      : bytes_(bytes)
-  {
-    void* p = mmap(
-        nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-    data_ = p == MAP_FAILED ? nullptr : static_cast<char*>(p);
-  }
-  ~Mapping()
-  {
-    if (data_)
-      munmap(data_, bytes_);
-  }
-  Mapping(const Mapping&) = delete;
-  Mapping& operator=(const Mapping&) = delete;
-  char* data() const { return data_; }
-
-private:
-  std::size_t bytes_;
-  char* data_ = nullptr;
-};
-
-/** Skips the calling test where the kernel takes no huge-page advice. */
-#define SKIP_WITHOUT_HUGE_PAGE_ADVICE()                                                \
-  do {                                                                                 \
-    Mapping probe(4 * kHugePage);                                                      \
-    ASSERT_NE(probe.data(), nullptr);                                                  \
-    const std::uintptr_t first = firstHugePage(probe.data());                          \
-    if (madvise(reinterpret_cast<void*>(first), kHugePage, MADV_HUGEPAGE) != 0 ||      \
-        !advised(first))                                                               \
-      GTEST_SKIP() << "this kernel takes no MADV_HUGEPAGE advice";                     \
-  } while (false)
+using selseg_test::advised;
+using selseg_test::firstHugePage;
+using selseg_test::kHugePage;
+using selseg_test::Mapping;
 
 TEST(AdviseHugePages, CoversExactlyTheWholeHugePagesInsideTheArray)
 {
@@ -189,7 +130,7 @@ TEST(LargeVectors, NewStorageOfALargeVectorIsAdvised)
   EXPECT_TRUE(advised(first + seg::kDefaultHugePageAdviceBytes));
 }
 
-#endif // __linux__ && MADV_HUGEPAGE
+#endif // SELSEG_TEST_HUGE_PAGE_ADVICE
 
 } // namespace
 

@@ -7,6 +7,8 @@
 // End-to-end tests of the command-line tool: outputs, exit codes, no partial output.
 // Arguments: the tool's path, then the bundled scan.
 
+#include <pcl_selective_seg/parameters.h>
+
 #include <gtest/gtest.h>
 #include <pcl/PCLPointCloud2.h>
 #include <pcl/common/io.h>
@@ -25,6 +27,7 @@
 #include <sstream>
 #include <string>
 
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -32,9 +35,12 @@
 #include <malloc.h>
 #endif
 
+#include "huge_page_advice.h"
 #include "outputs.h"
 #include "process_memory.h"
+#include "reliability/reliability_util.h"
 #include "roi_json.h"
+#include "scan_io.h"
 #include "segment_colors.h"
 
 namespace fs = std::filesystem;
@@ -414,6 +420,82 @@ TEST(KeepFreedMemory, YieldsToTheUsersMallocSettingsAndThenMapsNothing)
   EXPECT_FALSE(selseg_apps::keepFreedMemory());
 #endif
 }
+
+TEST_F(Tool, LoadScanGivesTheDeclaredPointsBeforeReadingThem)
+{
+  pcl::PointCloud<pcl::PointXYZ> cloud;
+  std::string error;
+  std::vector<std::size_t> declared;
+  const auto note = [&](std::size_t n) {
+    EXPECT_TRUE(cloud.empty()) << "called after the points were read";
+    declared.push_back(n);
+  };
+  // A PCD: its WIDTH x HEIGHT (the bundled scan: 640 x 480, NaN points included).
+  ASSERT_TRUE(selseg_apps::loadScan(scan, 1.0, cloud, error, note)) << error;
+  EXPECT_EQ(declared, std::vector<std::size_t>{640 * 480});
+  EXPECT_EQ(cloud.size(), 640u * 480u);
+  // A PLY: its vertex count.
+  pcl::PointCloud<pcl::PointXYZ> seven;
+  for (int i = 0; i < 7; ++i)
+    seven.push_back(pcl::PointXYZ(0.1f * i, 0.0f, 1.0f));
+  ASSERT_EQ(pcl::io::savePLYFileBinary(out("seven.ply"), seven), 0);
+  declared.clear();
+  ASSERT_TRUE(selseg_apps::loadScan(out("seven.ply"), 1.0, cloud, error, note))
+      << error;
+  EXPECT_EQ(declared, std::vector<std::size_t>{7});
+  EXPECT_EQ(cloud.size(), 7u);
+  // Text declares nothing; a file refused before its header is checked, nothing either.
+  std::ofstream(out("three.xyz")) << "0 0 1\n1 0 1\n0 1 1\n";
+  declared.clear();
+  ASSERT_TRUE(selseg_apps::loadScan(out("three.xyz"), 1.0, cloud, error, note))
+      << error;
+  EXPECT_EQ(cloud.size(), 3u);
+  std::ofstream(out("broken.pcd")) << "VERSION 0.7\nFIELDS x y z\nDATA ascii\n";
+  EXPECT_FALSE(selseg_apps::loadScan(out("broken.pcd"), 1.0, cloud, error, note));
+  EXPECT_TRUE(declared.empty());
+}
+
+#if defined(__GLIBC__) && defined(SELSEG_TEST_HUGE_PAGE_ADVICE)
+TEST(ReserveHeapInHugePages, LaterAllocationsComeFromAdvisedMemoryNotYetResident)
+{
+  EXPECT_FALSE(selseg_apps::reserveHeapInHugePages(0));
+  SKIP_WITHOUT_HUGE_PAGE_ADVICE();
+  ScopedEnv tunables("GLIBC_TUNABLES", nullptr);
+  for (const char* name : selseg_apps::kMallocOptionVariables)
+    ASSERT_EQ(std::getenv(name), nullptr) << name << " is set: cannot test the default";
+  if (!selseg_apps::keepFreedMemory())
+    GTEST_SKIP() << "the allocator ignores mallopt() (a sanitizer's allocator)";
+  // The tool's threshold; restored after the test.
+  const std::size_t threshold = pcl::selective_seg::getHugePageAdviceThreshold();
+  pcl::selective_seg::setHugePageAdviceThreshold(std::size_t{4} << 20);
+  const std::size_t resident = selseg_test::procStatusBytes("VmRSS");
+  const bool reserved = selseg_apps::reserveHeapInHugePages(std::size_t{256} << 20);
+  const std::size_t resident_after = selseg_test::procStatusBytes("VmRSS");
+  // A block taken from the heap afterwards lies in advised memory (without the
+  // reservation, the heap grows by plain 4 KB pages).
+  void* block = std::malloc(std::size_t{64} << 20);
+  const bool block_advised =
+      block && selseg_test::advised(selseg_test::firstHugePage(block) + (1 << 20));
+  std::free(block);
+  pcl::selective_seg::setHugePageAdviceThreshold(threshold);
+  ASSERT_TRUE(reserved);
+  EXPECT_TRUE(block_advised);
+  // Nothing of the 256 MB was written.
+  EXPECT_LT(resident_after, resident + (std::size_t{8} << 20));
+  // Under a limit on the address space (here 64 TB, then lifted again), nothing.
+  rlimit address_space{};
+  ASSERT_EQ(getrlimit(RLIMIT_AS, &address_space), 0);
+  if (address_space.rlim_cur == RLIM_INFINITY) {
+    rlimit limited = address_space;
+    limited.rlim_cur = rlim_t{1} << 46;
+    ASSERT_EQ(setrlimit(RLIMIT_AS, &limited), 0);
+    const bool reserved_under_limit =
+        selseg_apps::reserveHeapInHugePages(std::size_t{64} << 20);
+    ASSERT_EQ(setrlimit(RLIMIT_AS, &address_space), 0);
+    EXPECT_FALSE(reserved_under_limit);
+  }
+}
+#endif
 
 namespace {
 

@@ -9,6 +9,7 @@
 #include <pcl/console/print.h>
 
 #include <array>
+#include <cstddef>
 #include <new>
 
 namespace selseg_apps {
@@ -40,6 +41,24 @@ inline constexpr std::array<const char*, 5> kMallocOptionVariables = {
  *         glibc's malloc options (GLIBC_TUNABLES with glibc.malloc.*, or one of
  *         kMallocOptionVariables): the user's choice wins. */
 bool keepFreedMemory();
+
+/** \brief Grow the heap of a process that keeps its freed memory (after
+ * keepFreedMemory() returned true) by \a bytes at once, advised as huge-page memory.
+ *
+ * A block of \a bytes is taken from the heap, its whole 2 MB pages are advised as the
+ * library advises its own large arrays (pcl::selective_seg::detail::adviseHugePages(),
+ * with the threshold of setHugePageAdviceThreshold()), and it is freed: the heap, which
+ * is never trimmed, keeps it, and the allocations that follow (the scan, the
+ * pipeline's arrays, the outputs) come from it, one page fault for each 2 MB instead of
+ * each 4 KB first touched. Nothing is written to it: what the run does not use stays
+ * virtual, and the peak resident memory grows by at most the unused part of the huge
+ * pages the run touches (1-2 MB at 1M points; docs/performance.md, "Huge pages").
+ * \return false (nothing done) when the freed memory is not kept, when \a bytes is 0,
+ *         under a limit on the address space or the data segment (RLIMIT_AS,
+ *         RLIMIT_DATA: the reservation would spend that budget beyond what the run
+ *         needs), or when the allocator refuses the block (it is only virtual memory,
+ *         but a system that does not overcommit may refuse a large one). */
+bool reserveHeapInHugePages(std::size_t bytes);
 
 /** \brief Run \a work and return its exit code; when memory runs out in it beyond
  * what the library reports itself (std::bad_alloc out of \a work, whose stack unwinds

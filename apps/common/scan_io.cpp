@@ -216,9 +216,12 @@ asciiRowsUsable(const std::string& path,
 }
 
 /** The sizes a PCD header claims, read without PCL: PCL 1.13's readHeader already
- * allocates the data block the header claims, however large. */
+ * allocates the data block the header claims, however large. \a declared_points: the
+ * points it declares (the larger of POINTS and WIDTH x HEIGHT), when true. */
 bool
-pcdSizesPlausible(const std::string& path, std::string& error)
+pcdSizesPlausible(const std::string& path,
+                  std::string& error,
+                  unsigned long long& declared_points)
 {
   std::ifstream in(path, std::ios::binary);
   std::string line;
@@ -321,6 +324,7 @@ pcdSizesPlausible(const std::string& path, std::string& error)
   points = std::max(points, width * height);
   if (points > (1ull << 40))
     return corrupt("it claims an implausible number of points");
+  declared_points = points;
   const long long data_bytes =
       bytesAfter(path, static_cast<unsigned long long>(data_start));
   in.clear();
@@ -359,9 +363,11 @@ pcdSizesPlausible(const std::string& path, std::string& error)
 /** PCL 1.13's PCDReader::read crashes on some malformed headers (no fields): check the
  * header first. */
 bool
-pcdHeaderUsable(const std::string& path, std::string& error)
+pcdHeaderUsable(const std::string& path,
+                std::string& error,
+                unsigned long long& declared_points)
 {
-  if (!pcdSizesPlausible(path, error))
+  if (!pcdSizesPlausible(path, error, declared_points))
     return false;
   pcl::PCLPointCloud2 header;
   Eigen::Vector4f origin;
@@ -384,7 +390,9 @@ pcdHeaderUsable(const std::string& path, std::string& error)
  * positive integers whose product is the vertex count, or PCL writes past its data
  * (an assertion in PCL's PLY reader aborts the process). */
 bool
-plyHeaderUsable(const std::string& path, std::string& error)
+plyHeaderUsable(const std::string& path,
+                std::string& error,
+                unsigned long long& declared_points)
 {
   std::ifstream in(path, std::ios::binary);
   std::string line;
@@ -418,6 +426,7 @@ plyHeaderUsable(const std::string& path, std::string& error)
                 " vertices: the header is corrupt";
         return false;
       }
+      declared_points = static_cast<unsigned long long>(std::max(vertices, 0ll));
       return plausibleSize(path, values, bytesAfter(path, in.tellg()), error);
     }
     if (keyword == "comment")
@@ -578,14 +587,19 @@ loadBinaryFormat(const std::string& path,
                  const std::string& ext,
                  pcl::PointCloud<pcl::PointXYZ>& cloud,
                  std::string& error,
+                 const DeclaredPointsHook& before_reading = {},
                  std::vector<std::uint32_t>* labels = nullptr)
 {
   pcl::PCLPointCloud2 blob;
   Eigen::Vector4f origin = Eigen::Vector4f::Zero();
   Eigen::Quaternionf orientation = Eigen::Quaternionf::Identity();
   int version = 0;
-  if (ext == ".pcd" ? !pcdHeaderUsable(path, error) : !plyHeaderUsable(path, error))
+  unsigned long long declared = 0;
+  if (ext == ".pcd" ? !pcdHeaderUsable(path, error, declared)
+                    : !plyHeaderUsable(path, error, declared))
     return false;
+  if (before_reading)
+    before_reading(static_cast<std::size_t>(declared));
   int rc = -1;
   try {
     rc = ext == ".pcd"
@@ -666,13 +680,14 @@ bool
 loadScan(const std::string& path,
          double unit_scale,
          pcl::PointCloud<pcl::PointXYZ>& cloud,
-         std::string& error)
+         std::string& error,
+         const DeclaredPointsHook& before_reading)
 {
   cloud.clear();
   const std::string ext = lowerExtension(path);
   if (!guardedLoad(path, error, [&] {
         return (ext == ".pcd" || ext == ".ply")
-                   ? loadBinaryFormat(path, ext, cloud, error)
+                   ? loadBinaryFormat(path, ext, cloud, error, before_reading)
                    : loadText(path, cloud, error);
       })) {
     cloud.clear();
@@ -709,7 +724,7 @@ loadLabeledScan(const std::string& path,
     return false;
   }
   if (!guardedLoad(path, error, [&] {
-        return loadBinaryFormat(path, ".pcd", cloud, error, &labels);
+        return loadBinaryFormat(path, ".pcd", cloud, error, {}, &labels);
       })) {
     cloud.clear();
     labels.clear();

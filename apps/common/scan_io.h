@@ -9,7 +9,9 @@
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 
+#include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -18,6 +20,11 @@ namespace selseg_apps {
 /** \brief The file name's extension from its last dot, lower case (".pcd"), or "" when
  * it has none. */
 std::string lowerExtension(const std::string& path);
+
+/** \brief Called by loadScan() with the number of points a PCD or PLY file declares
+ * (PCD: the larger of POINTS and WIDTH x HEIGHT; PLY: its vertex count), once its
+ * header has been checked and before its points are read. */
+using DeclaredPointsHook = std::function<void(std::size_t)>;
 
 /** \brief Read a scan: PCD or PLY (any point type with x, y and z fields) or plain text
  * with "x y z" per line (further columns ignored, '#' comments and blank lines
@@ -29,11 +36,14 @@ std::string lowerExtension(const std::string& path);
  * \param[in] unit_scale factor applied to every coordinate (0.01 for centimetres)
  * \param[out] cloud the points, in input order
  * \param[out] error what is wrong with the file and what to do, when false
+ * \param[in] before_reading if set, called with the points a PCD or PLY header declares
+ * before they are read (not for text files)
  * \return false when the file cannot be read or has no x, y, z */
 bool loadScan(const std::string& path,
               double unit_scale,
               pcl::PointCloud<pcl::PointXYZ>& cloud,
-              std::string& error);
+              std::string& error,
+              const DeclaredPointsHook& before_reading = {});
 
 /** \brief Whether a -unit_scale value is usable: in [1e-12, 1e12] (far beyond any unit
  * change; outside, coordinates overflow or underflow float), else false with a
