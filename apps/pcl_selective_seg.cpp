@@ -25,6 +25,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -436,7 +437,8 @@ segment(const Options& opt)
   // or by the points read from a text file.
   bool reserved = false;
   const auto reserve = [&](std::size_t points) {
-    reserved = selseg_apps::reserveHeapInHugePages(points * kHeapBytesPerPoint);
+    reserved = points <= std::numeric_limits<std::size_t>::max() / kHeapBytesPerPoint &&
+               selseg_apps::reserveHeapInHugePages(points * kHeapBytesPerPoint);
   };
   if (!selseg_apps::loadScan(opt.input, opt.unit_scale, *cloud, error, reserve)) {
     print_error("%s\n", error.c_str());

@@ -416,6 +416,15 @@ TEST(KeepFreedMemory, YieldsToTheUsersMallocSettingsAndThenMapsNothing)
   static_cast<volatile char*>(block)[0] = 1;
   EXPECT_EQ(mallinfo2().hblks, mapped_before);
   std::free(block);
+  // Nor is a free top of 2 GB or more given back (with INT_MAX as the trim threshold it
+  // was): 2.5 GB, one byte of it written.
+  void* huge = std::malloc(std::size_t{5} << 29);
+  if (huge) {
+    static_cast<volatile char*>(huge)[0] = 1;
+    const void* grown = sbrk(0);
+    std::free(huge);
+    EXPECT_EQ(sbrk(0), grown) << "the heap was trimmed";
+  }
 #else
   EXPECT_FALSE(selseg_apps::keepFreedMemory());
 #endif
@@ -463,6 +472,12 @@ TEST(ReserveHeapInHugePages, LaterAllocationsComeFromAdvisedMemoryNotYetResident
   ScopedEnv tunables("GLIBC_TUNABLES", nullptr);
   for (const char* name : selseg_apps::kMallocOptionVariables)
     ASSERT_EQ(std::getenv(name), nullptr) << name << " is set: cannot test the default";
+  for (const int resource : {RLIMIT_AS, RLIMIT_DATA}) {
+    rlimit limit{};
+    ASSERT_EQ(getrlimit(resource, &limit), 0);
+    if (limit.rlim_cur != RLIM_INFINITY)
+      GTEST_SKIP() << "the address space or the data segment is limited (ulimit)";
+  }
   if (!selseg_apps::keepFreedMemory())
     GTEST_SKIP() << "the allocator ignores mallopt() (a sanitizer's allocator)";
   // The tool's threshold; restored after the test.
@@ -482,17 +497,19 @@ TEST(ReserveHeapInHugePages, LaterAllocationsComeFromAdvisedMemoryNotYetResident
   EXPECT_TRUE(block_advised);
   // Nothing of the 256 MB was written.
   EXPECT_LT(resident_after, resident + (std::size_t{8} << 20));
-  // Under a limit on the address space (here 64 TB, then lifted again), nothing.
-  rlimit address_space{};
-  ASSERT_EQ(getrlimit(RLIMIT_AS, &address_space), 0);
-  if (address_space.rlim_cur == RLIM_INFINITY) {
-    rlimit limited = address_space;
+  // Under a limit on the address space or the data segment (here 64 TB, then lifted
+  // again), nothing.
+  for (const int resource : {RLIMIT_AS, RLIMIT_DATA}) {
+    rlimit unlimited{};
+    ASSERT_EQ(getrlimit(resource, &unlimited), 0);
+    rlimit limited = unlimited;
     limited.rlim_cur = rlim_t{1} << 46;
-    ASSERT_EQ(setrlimit(RLIMIT_AS, &limited), 0);
+    ASSERT_EQ(setrlimit(resource, &limited), 0);
     const bool reserved_under_limit =
         selseg_apps::reserveHeapInHugePages(std::size_t{64} << 20);
-    ASSERT_EQ(setrlimit(RLIMIT_AS, &address_space), 0);
-    EXPECT_FALSE(reserved_under_limit);
+    ASSERT_EQ(setrlimit(resource, &unlimited), 0);
+    EXPECT_FALSE(reserved_under_limit)
+        << (resource == RLIMIT_AS ? "RLIMIT_AS" : "RLIMIT_DATA");
   }
 }
 #endif

@@ -8,9 +8,9 @@
 
 #include <pcl_selective_seg/impl/large_arrays.hpp>
 
-#include <climits>
 #include <cstdlib>
 #include <cstring>
+#include <initializer_list>
 
 #if defined(__GLIBC__)
 #include <malloc.h>
@@ -37,8 +37,10 @@ keepFreedMemory()
     if (std::getenv(name))
       return false;
   // Every allocation from the heap, and the heap never given back: a freed array is
-  // there for the next stage's.
-  heap_kept = mallopt(M_MMAP_MAX, 0) == 1 && mallopt(M_TRIM_THRESHOLD, INT_MAX) == 1;
+  // there for the next stage's. -1 turns trimming off whatever the heap's size (INT_MAX
+  // would still trim a free top of 2 GB or more, e.g. a reservation for a scan of 5.4M
+  // points).
+  heap_kept = mallopt(M_MMAP_MAX, 0) == 1 && mallopt(M_TRIM_THRESHOLD, -1) == 1;
   return heap_kept;
 #else
   return false;

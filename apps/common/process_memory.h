@@ -51,9 +51,13 @@ bool keepFreedMemory();
  * is never trimmed, keeps it, and the allocations that follow (the scan, the
  * pipeline's arrays, the outputs) come from it, one page fault for each 2 MB instead of
  * each 4 KB first touched. Nothing is written to it: what the run does not use stays
- * virtual, and the peak resident memory grows by at most the unused part of the huge
- * pages the run touches (1-2 MB at 1M points; docs/performance.md, "Huge pages").
- * \return false (nothing done) when the freed memory is not kept, when \a bytes is 0,
+ * virtual, and the peak resident memory grows by the unwritten parts of the huge pages
+ * the run touches (0.4-2.3 MiB at 1M points; docs/performance.md, "Huge pages"). Call
+ * it from the main thread: glibc serves another thread's large requests apart from
+ * the heap. The block need not be used up: its size costs only address space.
+ * \return true when the block was taken and freed into the heap (whether the kernel
+ *         takes the advice is its setting's affair, as for the library's arrays);
+ *         false (nothing done) when the freed memory is not kept, when \a bytes is 0,
  *         under a limit on the address space or the data segment (RLIMIT_AS,
  *         RLIMIT_DATA: the reservation would spend that budget beyond what the run
  *         needs), or when the allocator refuses the block (it is only virtual memory,
