@@ -409,7 +409,7 @@ writeOutputs(const Options& opt,
               return writeMeshVtk(f, cloud, r.mesh, threads);
             }) &&
       write(opt.leaves,
-            [&](const std::string& f) { return writeLeaves(f, r.leaves); }) &&
+            [&](const std::string& f) { return writeLeaves(f, r.leaves, threads); }) &&
       write(opt.json,
             [&](const std::string& f) {
               return writeSummaryJson(f, info, r, threads);

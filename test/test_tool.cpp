@@ -15,6 +15,7 @@
 #include <pcl/conversions.h>
 #include <pcl/io/pcd_io.h>
 #include <pcl/io/ply_io.h>
+#include <pcl/register_point_struct.h>
 
 #include <cstdlib>
 #include <cstring>
@@ -42,6 +43,29 @@
 #include "roi_json.h"
 #include "scan_io.h"
 #include "segment_colors.h"
+
+// The leaves file's point type as PCL would write it (the tool's is private to
+// outputs.cpp): the reference for the leaves writer's bytes.
+namespace selseg_test {
+struct EIGEN_ALIGN16 ReferenceLeafPoint {
+  PCL_ADD_POINT4D;
+  float size;
+  std::uint32_t depth;
+  std::uint32_t label;
+  float normal_x, normal_y, normal_z;
+  float sigma_theta, sigma_phi;
+  std::uint32_t num_points;
+  PCL_MAKE_ALIGNED_OPERATOR_NEW
+};
+} // namespace selseg_test
+
+POINT_CLOUD_REGISTER_POINT_STRUCT(
+    selseg_test::ReferenceLeafPoint,
+    (float, x, x)(float, y, y)(float, z, z)(float, size, size)(
+        std::uint32_t, depth, depth)(std::uint32_t, label, label)(
+        float, normal_x, normal_x)(float, normal_y, normal_y)(
+        float, normal_z, normal_z)(float, sigma_theta, sigma_theta)(
+        float, sigma_phi, sigma_phi)(std::uint32_t, num_points, num_points))
 
 namespace fs = std::filesystem;
 
@@ -566,6 +590,48 @@ struct HandMadeMesh {
 // The mesh files byte by byte: vertices numbered by first use, every number in the
 // format's byte order, each face's colour (its segment's, or white on an edge), label
 // and class.
+TEST(LeavesWriter, BytesOfPclsBinaryWriterForAnyThreadCount)
+{
+  // 60,000 leaves: several of the writer's blocks; values of every field distinct.
+  std::vector<pcl::selective_seg::OctreeLeaf> leaves(60000);
+  pcl::PointCloud<selseg_test::ReferenceLeafPoint> reference;
+  for (std::size_t l = 0; l < leaves.size(); ++l) {
+    auto& in = leaves[l];
+    const auto f = static_cast<float>(l);
+    in.centre = Eigen::Vector3f(f, -0.5f * f, 1.0f + 1e-3f * f);
+    in.size = 0.01f * (1.0f + static_cast<float>(l % 7));
+    in.depth = static_cast<std::uint32_t>(l % 11);
+    in.label = static_cast<std::uint32_t>(l / 3);
+    in.normal = Eigen::Vector3f(0.1f, -0.2f, f).normalized();
+    in.sigma_theta = 1e-4f * f;
+    in.sigma_phi = 2e-4f * f;
+    in.area = 5.0; // not written
+    in.num_points = static_cast<std::uint32_t>(l % 1000);
+    selseg_test::ReferenceLeafPoint p;
+    p.getVector3fMap() = in.centre;
+    p.size = in.size;
+    p.depth = in.depth;
+    p.label = in.label;
+    p.normal_x = in.normal.x();
+    p.normal_y = in.normal.y();
+    p.normal_z = in.normal.z();
+    p.sigma_theta = in.sigma_theta;
+    p.sigma_phi = in.sigma_phi;
+    p.num_points = in.num_points;
+    reference.push_back(p);
+  }
+  const ScratchDir dir("selseg_leaves_writer");
+  ASSERT_EQ(pcl::io::savePCDFileBinary(dir.file("pcl.pcd"), reference), 0);
+  const std::string expected = fileBytes(dir.file("pcl.pcd"));
+  ASSERT_GT(expected.size(), 48u * leaves.size());
+  for (const int threads : {1, 3}) {
+    ASSERT_TRUE(selseg_apps::writeLeaves(dir.file("leaves.pcd"), leaves, threads));
+    EXPECT_TRUE(fileBytes(dir.file("leaves.pcd")) == expected) << threads << " threads";
+  }
+  // No leaf: nothing to write, as PCL's writer refuses an empty cloud.
+  EXPECT_FALSE(selseg_apps::writeLeaves(dir.file("none.pcd"), {}));
+}
+
 TEST(MeshWriters, KnownBytesForAHandMadeMesh)
 {
   const HandMadeMesh m;

@@ -140,7 +140,7 @@ writeRecords(std::ostream& out,
              int threads,
              const Fill& fill)
 {
-  const std::size_t per_block = std::max<std::size_t>(1, (std::size_t{1} << 22) / size);
+  const std::size_t per_block = std::max<std::size_t>(1, (std::size_t{1} << 20) / size);
   std::vector<char> block(std::min(count, per_block) * size);
   for (std::size_t first = 0; first < count && out; first += per_block) {
     const auto n = static_cast<std::ptrdiff_t>(std::min(per_block, count - first));
@@ -643,30 +643,48 @@ writeMeshVtk(const std::string& path,
 
 bool
 writeLeaves(const std::string& path,
-            const std::vector<pcl::selective_seg::OctreeLeaf>& leaves)
+            const std::vector<pcl::selective_seg::OctreeLeaf>& leaves,
+            int threads)
 {
-  pcl::PointCloud<LeafPoint> cloud;
-  cloud.resize(leaves.size());
-  for (std::size_t l = 0; l < leaves.size(); ++l) {
+  const std::size_t n = leaves.size();
+  if (n == 0 || n > static_cast<std::size_t>(std::numeric_limits<int>::max()))
+    return false;
+  // The bytes of pcl::io::savePCDFileBinary() for a cloud of LeafPoint: PCL's header
+  // for n points in one row (a cloud of that shape, without points), then each point's
+  // fields in their order, padding left out. Written a block at a time instead of
+  // through a map of the whole file, whose pages would count in the resident memory.
+  std::vector<pcl::PCLPointField> fields;
+  for (const auto& field : pcl::getFields<LeafPoint>())
+    if (field.name != "_")
+      fields.push_back(field);
+  std::size_t record = 0;
+  for (const auto& field : fields)
+    record += field.count * pcl::getFieldSize(field.datatype);
+  std::ofstream out(path, std::ios::binary);
+  out << pcl::PCDWriter::generateHeader(pcl::PointCloud<LeafPoint>(),
+                                        static_cast<int>(n))
+      << "DATA binary\n";
+  writeRecords(out, n, record, threads, [&](std::size_t l, char* p) {
     const auto& in = leaves[l];
-    auto& p = cloud[l];
-    p.getVector3fMap() = in.centre;
-    p.size = in.size;
-    p.depth = in.depth;
-    p.label = in.label;
-    p.normal_x = in.normal.x();
-    p.normal_y = in.normal.y();
-    p.normal_z = in.normal.z();
-    p.sigma_theta = in.sigma_theta;
-    p.sigma_phi = in.sigma_phi;
-    p.num_points = in.num_points;
-  }
-  try {
-    if (!cloud.empty() && pcl::io::savePCDFileBinary(path, cloud) == 0)
-      return true;
-  } catch (const pcl::IOException&) {
-  }
-  return false;
+    LeafPoint point;
+    point.getVector3fMap() = in.centre;
+    point.size = in.size;
+    point.depth = in.depth;
+    point.label = in.label;
+    point.normal_x = in.normal.x();
+    point.normal_y = in.normal.y();
+    point.normal_z = in.normal.z();
+    point.sigma_theta = in.sigma_theta;
+    point.sigma_phi = in.sigma_phi;
+    point.num_points = in.num_points;
+    for (const auto& field : fields) {
+      const std::size_t bytes = field.count * pcl::getFieldSize(field.datatype);
+      std::memcpy(p, reinterpret_cast<const char*>(&point) + field.offset, bytes);
+      p += bytes;
+    }
+  });
+  out.close();
+  return static_cast<bool>(out);
 }
 
 bool

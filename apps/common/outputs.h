@@ -109,9 +109,13 @@ bool writeMeshVtk(const std::string& path,
                   int threads = 1);
 
 /** \brief The octree leaves as a PCD, one point per leaf: x y z (centre, cloud frame)
- * size depth label normal_x normal_y normal_z sigma_theta sigma_phi num_points. */
+ * size depth label normal_x normal_y normal_z sigma_theta sigma_phi num_points. The
+ * bytes of pcl::io::savePCDFileBinary() for those points, made on \a threads threads
+ * and written a block at a time (PCL maps the whole file, and a mapped page counts in
+ * the resident memory). False for no leaf, as PCL's writer. */
 bool writeLeaves(const std::string& path,
-                 const std::vector<pcl::selective_seg::OctreeLeaf>& leaves);
+                 const std::vector<pcl::selective_seg::OctreeLeaf>& leaves,
+                 int threads = 1);
 
 /** \brief What the JSON summary reports besides the result. */
 struct RunInfo {
