@@ -15,7 +15,6 @@
 #include <pcl/conversions.h>
 #include <pcl/io/pcd_io.h>
 #include <pcl/io/ply_io.h>
-#include <pcl/register_point_struct.h>
 
 #include <cstdlib>
 #include <cstring>
@@ -43,29 +42,6 @@
 #include "roi_json.h"
 #include "scan_io.h"
 #include "segment_colors.h"
-
-// The leaves file's point type as PCL would write it (the tool's is private to
-// outputs.cpp): the reference for the leaves writer's bytes.
-namespace selseg_test {
-struct EIGEN_ALIGN16 ReferenceLeafPoint {
-  PCL_ADD_POINT4D;
-  float size;
-  std::uint32_t depth;
-  std::uint32_t label;
-  float normal_x, normal_y, normal_z;
-  float sigma_theta, sigma_phi;
-  std::uint32_t num_points;
-  PCL_MAKE_ALIGNED_OPERATOR_NEW
-};
-} // namespace selseg_test
-
-POINT_CLOUD_REGISTER_POINT_STRUCT(
-    selseg_test::ReferenceLeafPoint,
-    (float, x, x)(float, y, y)(float, z, z)(float, size, size)(
-        std::uint32_t, depth, depth)(std::uint32_t, label, label)(
-        float, normal_x, normal_x)(float, normal_y, normal_y)(
-        float, normal_z, normal_z)(float, sigma_theta, sigma_theta)(
-        float, sigma_phi, sigma_phi)(std::uint32_t, num_points, num_points))
 
 namespace fs = std::filesystem;
 
@@ -594,7 +570,7 @@ TEST(LeavesWriter, BytesOfPclsBinaryWriterForAnyThreadCount)
 {
   // 60,000 leaves: several of the writer's blocks; values of every field distinct.
   std::vector<pcl::selective_seg::OctreeLeaf> leaves(60000);
-  pcl::PointCloud<selseg_test::ReferenceLeafPoint> reference;
+  pcl::PointCloud<selseg_apps::LeafPoint> reference; // written by PCL
   for (std::size_t l = 0; l < leaves.size(); ++l) {
     auto& in = leaves[l];
     const auto f = static_cast<float>(l);
@@ -607,18 +583,7 @@ TEST(LeavesWriter, BytesOfPclsBinaryWriterForAnyThreadCount)
     in.sigma_phi = 2e-4f * f;
     in.area = 5.0; // not written
     in.num_points = static_cast<std::uint32_t>(l % 1000);
-    selseg_test::ReferenceLeafPoint p;
-    p.getVector3fMap() = in.centre;
-    p.size = in.size;
-    p.depth = in.depth;
-    p.label = in.label;
-    p.normal_x = in.normal.x();
-    p.normal_y = in.normal.y();
-    p.normal_z = in.normal.z();
-    p.sigma_theta = in.sigma_theta;
-    p.sigma_phi = in.sigma_phi;
-    p.num_points = in.num_points;
-    reference.push_back(p);
+    reference.push_back(selseg_apps::leafPoint(in));
   }
   const ScratchDir dir("selseg_leaves_writer");
   ASSERT_EQ(pcl::io::savePCDFileBinary(dir.file("pcl.pcd"), reference), 0);

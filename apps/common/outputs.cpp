@@ -33,30 +33,6 @@
 #include <unistd.h>
 
 namespace selseg_apps {
-
-/** One octree leaf as a PCD point. */
-struct EIGEN_ALIGN16 LeafPoint {
-  PCL_ADD_POINT4D;
-  float size;
-  std::uint32_t depth;
-  std::uint32_t label;
-  float normal_x, normal_y, normal_z;
-  float sigma_theta, sigma_phi;
-  std::uint32_t num_points;
-  PCL_MAKE_ALIGNED_OPERATOR_NEW
-};
-
-} // namespace selseg_apps
-
-POINT_CLOUD_REGISTER_POINT_STRUCT(
-    selseg_apps::LeafPoint,
-    (float, x, x)(float, y, y)(float, z, z)(float, size, size)(
-        std::uint32_t, depth, depth)(std::uint32_t, label, label)(
-        float, normal_x, normal_x)(float, normal_y, normal_y)(
-        float, normal_z, normal_z)(float, sigma_theta, sigma_theta)(
-        float, sigma_phi, sigma_phi)(std::uint32_t, num_points, num_points))
-
-namespace selseg_apps {
 namespace {
 
 using pcl::selective_seg::SegmentedMesh;
@@ -641,6 +617,23 @@ writeMeshVtk(const std::string& path,
   return static_cast<bool>(out);
 }
 
+LeafPoint
+leafPoint(const pcl::selective_seg::OctreeLeaf& leaf)
+{
+  LeafPoint point;
+  point.getVector3fMap() = leaf.centre;
+  point.size = leaf.size;
+  point.depth = leaf.depth;
+  point.label = leaf.label;
+  point.normal_x = leaf.normal.x();
+  point.normal_y = leaf.normal.y();
+  point.normal_z = leaf.normal.z();
+  point.sigma_theta = leaf.sigma_theta;
+  point.sigma_phi = leaf.sigma_phi;
+  point.num_points = leaf.num_points;
+  return point;
+}
+
 bool
 writeLeaves(const std::string& path,
             const std::vector<pcl::selective_seg::OctreeLeaf>& leaves,
@@ -665,18 +658,7 @@ writeLeaves(const std::string& path,
                                         static_cast<int>(n))
       << "DATA binary\n";
   writeRecords(out, n, record, threads, [&](std::size_t l, char* p) {
-    const auto& in = leaves[l];
-    LeafPoint point;
-    point.getVector3fMap() = in.centre;
-    point.size = in.size;
-    point.depth = in.depth;
-    point.label = in.label;
-    point.normal_x = in.normal.x();
-    point.normal_y = in.normal.y();
-    point.normal_z = in.normal.z();
-    point.sigma_theta = in.sigma_theta;
-    point.sigma_phi = in.sigma_phi;
-    point.num_points = in.num_points;
+    const LeafPoint point = leafPoint(leaves[l]);
     for (const auto& field : fields) {
       const std::size_t bytes = field.count * pcl::getFieldSize(field.datatype);
       std::memcpy(p, reinterpret_cast<const char*>(&point) + field.offset, bytes);

@@ -11,7 +11,9 @@
 
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
+#include <pcl/register_point_struct.h>
 
+#include <cstdint>
 #include <string>
 #include <utility>
 #include <vector>
@@ -108,6 +110,21 @@ bool writeMeshVtk(const std::string& path,
                   const pcl::selective_seg::SegmentedMesh& mesh,
                   int threads = 1);
 
+/** \brief A point of the leaves file (writeLeaves()). */
+struct EIGEN_ALIGN16 LeafPoint {
+  PCL_ADD_POINT4D;
+  float size;
+  std::uint32_t depth;
+  std::uint32_t label;
+  float normal_x, normal_y, normal_z;
+  float sigma_theta, sigma_phi;
+  std::uint32_t num_points;
+  PCL_MAKE_ALIGNED_OPERATOR_NEW
+};
+
+/** \brief The leaves file's point for a leaf (its area is left out). */
+LeafPoint leafPoint(const pcl::selective_seg::OctreeLeaf& leaf);
+
 /** \brief The octree leaves as a PCD, one point per leaf: x y z (centre, cloud frame)
  * size depth label normal_x normal_y normal_z sigma_theta sigma_phi num_points. The
  * bytes of pcl::io::savePCDFileBinary() for those points, made on \a threads threads
@@ -137,3 +154,11 @@ bool writeSummaryJson(const std::string& path,
                       int threads = 1);
 
 } // namespace selseg_apps
+
+POINT_CLOUD_REGISTER_POINT_STRUCT(
+    selseg_apps::LeafPoint,
+    (float, x, x)(float, y, y)(float, z, z)(float, size, size)(
+        std::uint32_t, depth, depth)(std::uint32_t, label, label)(
+        float, normal_x, normal_x)(float, normal_y, normal_y)(
+        float, normal_z, normal_z)(float, sigma_theta, sigma_theta)(
+        float, sigma_phi, sigma_phi)(std::uint32_t, num_points, num_points))
