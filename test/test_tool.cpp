@@ -563,9 +563,6 @@ struct HandMadeMesh {
 
 } // namespace
 
-// The mesh files byte by byte: vertices numbered by first use, every number in the
-// format's byte order, each face's colour (its segment's, or white on an edge), label
-// and class.
 TEST(LeavesWriter, BytesOfPclsBinaryWriterForAnyThreadCount)
 {
   // 60,000 leaves: several of the writer's blocks; values of every field distinct.
@@ -597,6 +594,9 @@ TEST(LeavesWriter, BytesOfPclsBinaryWriterForAnyThreadCount)
   EXPECT_FALSE(selseg_apps::writeLeaves(dir.file("none.pcd"), {}));
 }
 
+// The mesh files byte by byte: vertices numbered by first use, every number in the
+// format's byte order, each face's colour (its segment's, or white on an edge), label
+// and class.
 TEST(MeshWriters, KnownBytesForAHandMadeMesh)
 {
   const HandMadeMesh m;

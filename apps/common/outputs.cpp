@@ -646,13 +646,16 @@ writeLeaves(const std::string& path,
   // for n points in one row (a cloud of that shape, without points), then each point's
   // fields in their order, padding left out. Written a block at a time instead of
   // through a map of the whole file, whose pages would count in the resident memory.
-  std::vector<pcl::PCLPointField> fields;
-  for (const auto& field : pcl::getFields<LeafPoint>())
-    if (field.name != "_")
-      fields.push_back(field);
+  struct FieldBytes {
+    std::size_t offset, size;
+  };
+  std::vector<FieldBytes> fields;
   std::size_t record = 0;
-  for (const auto& field : fields)
-    record += field.count * pcl::getFieldSize(field.datatype);
+  for (const auto& field : pcl::getFields<LeafPoint>())
+    if (field.name != "_") {
+      fields.push_back({field.offset, field.count * pcl::getFieldSize(field.datatype)});
+      record += fields.back().size;
+    }
   std::ofstream out(path, std::ios::binary);
   out << pcl::PCDWriter::generateHeader(pcl::PointCloud<LeafPoint>(),
                                         static_cast<int>(n))
@@ -660,9 +663,8 @@ writeLeaves(const std::string& path,
   writeRecords(out, n, record, threads, [&](std::size_t l, char* p) {
     const LeafPoint point = leafPoint(leaves[l]);
     for (const auto& field : fields) {
-      const std::size_t bytes = field.count * pcl::getFieldSize(field.datatype);
-      std::memcpy(p, reinterpret_cast<const char*>(&point) + field.offset, bytes);
-      p += bytes;
+      std::memcpy(p, reinterpret_cast<const char*>(&point) + field.offset, field.size);
+      p += field.size;
     }
   });
   out.close();

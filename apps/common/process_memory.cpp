@@ -61,11 +61,11 @@ reserveHeapInHugePages(std::size_t bytes)
       return false;
   }
 #endif
+  // Only the block's address is used: nothing is read (GCC takes a const pointer to
+  // uninitialized memory for a read, hence the pragma).
   void* block = std::malloc(bytes);
   if (!block)
     return false;
-    // Only the block's address is used: nothing is read (GCC takes a const pointer to
-    // uninitialized memory for a read).
 #if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
