@@ -16,12 +16,15 @@
 #include <pcl/conversions.h>
 
 #include <algorithm>
+#include <array>
+#include <atomic>
 #include <cstdio>
 #include <limits>
 #include <map>
 #include <numeric>
 #include <random>
 #include <set>
+#include <thread>
 
 #include <cube_scene.h>
 
@@ -905,6 +908,108 @@ TEST(SelectiveSegmentation, GettersDescribeTheLastRun)
       ASSERT_LT(v, cloud->size());
   ASSERT_TRUE(seg.getLabeledCloud());
   EXPECT_EQ(seg.getLabeledCloud()->size(), cloud->size());
+}
+
+// getPointNormals() builds its cloud on the first call after a run: callers on
+// several threads at once (a const segmenter shared by readers) all get that one cloud.
+TEST(SelectiveSegmentation, PointNormalsAreBuiltOnceForConcurrentCallers)
+{
+  const auto cloud = wall(30, 30);
+  SelectiveSegmentation<pcl::PointXYZ> seg;
+  std::vector<pcl::PointIndices> clusters;
+  constexpr int kThreads = 4;
+  for (int round = 0; round < 150; ++round) {
+    ASSERT_TRUE(segment<pcl::PointXYZ>(cloud, seg, clusters)); // a new run: no cache
+    const SelectiveSegmentation<pcl::PointXYZ>& reader = seg;
+    std::array<pcl::PointCloud<pcl::Normal>::ConstPtr, kThreads> got;
+    std::atomic<int> ready{0};
+    std::vector<std::thread> threads;
+    for (int t = 0; t < kThreads; ++t)
+      threads.emplace_back([&, t] {
+        ++ready;
+        while (ready.load() < kThreads)
+          std::this_thread::yield();
+        got[t] = reader.getPointNormals();
+      });
+    for (auto& thread : threads)
+      thread.join();
+    ASSERT_TRUE(got[0]);
+    EXPECT_EQ(got[0]->size(), cloud->size());
+    for (int t = 1; t < kThreads; ++t)
+      ASSERT_EQ(got[t], got[0]) << "round " << round << ", thread " << t;
+  }
+}
+
+// A failed run leaves no getter describing an earlier one: the triangulation is empty
+// and the sensor pose is the one in use, whether the failure is a parameter or the
+// geometry.
+TEST(SelectiveSegmentation, FailedRunForgetsTheTriangulationAndPose)
+{
+  const auto cloud = wall(20, 20);
+  Eigen::Affine3f first = Eigen::Affine3f::Identity();
+  first.translation() = Eigen::Vector3f(0.0f, 0.0f, -1.0f);
+  Eigen::Affine3f second = Eigen::Affine3f::Identity();
+  second.translation() = Eigen::Vector3f(0.0f, 0.0f, -2.0f);
+  const auto run = [&](SelectiveSegmentation<pcl::PointXYZ>& seg,
+                       const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& input) {
+    std::vector<pcl::PointIndices> clusters;
+    return segment<pcl::PointXYZ>(input, seg, clusters);
+  };
+
+  SelectiveSegmentation<pcl::PointXYZ> seg;
+  seg.setSensorPose(first);
+  ASSERT_TRUE(run(seg, cloud));
+  ASSERT_EQ(seg.getTriangulation().vertex_point.size(), cloud->size());
+  ASSERT_FALSE(seg.getTriangulation().triangles.empty());
+  seg.setSensorPose(second);
+  EXPECT_TRUE(seg.getSensorPose().isApprox(first)); // the run's pose
+  seg.setMaxMergeAngle(-1.0);                       // invalid
+  EXPECT_FALSE(run(seg, cloud));
+  EXPECT_TRUE(seg.getTriangulation().vertex_point.empty());
+  EXPECT_TRUE(seg.getTriangulation().triangles.empty());
+  EXPECT_TRUE(seg.getSensorPose().isApprox(second)); // the pose in use
+  EXPECT_TRUE(seg.getResult().labels.empty());
+
+  // Geometry: points on one 3-D line are triangulated, then refused.
+  seg.setMaxMergeAngle(25.0 * M_PI / 180.0);
+  seg.setSensorPose(first);
+  ASSERT_TRUE(run(seg, cloud));
+  auto line = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  for (int i = 0; i < 50; ++i)
+    line->push_back(pcl::PointXYZ(0.01f * i, 0.02f * i, 2.0f + 0.005f * i));
+  EXPECT_FALSE(run(seg, line));
+  EXPECT_TRUE(seg.getTriangulation().triangles.empty());
+  EXPECT_TRUE(seg.getTriangulation().vertex_point.empty());
+  EXPECT_FALSE(seg.getLabeledCloud());
+  EXPECT_FALSE(seg.getPointNormals());
+  // The counts keep why points were set aside (none here), and add up to no more than
+  // the input.
+  const auto& c = seg.getResult().counts;
+  EXPECT_EQ(c.labeled, 0u);
+  EXPECT_EQ(c.non_finite + c.behind_sensor + c.outside_indices, 0u);
+}
+
+// Points whose extent does not fit a float (up to twice float's largest value): no
+// leaf of infinite size; the run is refused with a message.
+TEST(SelectiveSegmentation, ExtentBeyondFloatIsRefusedNotInfinite)
+{
+  const float big = std::numeric_limits<float>::max();
+  auto cloud = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  for (int r = 0; r < 10; ++r)
+    for (int c = 0; c < 10; ++c)
+      cloud->push_back(pcl::PointXYZ(0.9f * big * ((c - 4.5f) / 4.5f),
+                                     0.02f * big * (r - 4.5f) / 4.5f,
+                                     0.95f * big));
+  SelectiveSegmentation<pcl::PointXYZ> seg;
+  std::vector<pcl::PointIndices> clusters;
+  const bool ok = segment<pcl::PointXYZ>(cloud, seg, clusters);
+  for (const auto& leaf : seg.getResult().leaves) {
+    EXPECT_TRUE(std::isfinite(leaf.size));
+    EXPECT_TRUE(leaf.centre.allFinite());
+  }
+  EXPECT_FALSE(ok);
+  EXPECT_TRUE(clusters.empty());
+  EXPECT_TRUE(seg.getResult().leaves.empty());
 }
 
 TEST(SelectiveSegmentation, CloudWhoseLayoutIsNotItsSize)

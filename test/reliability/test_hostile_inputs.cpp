@@ -176,23 +176,36 @@ TEST(HostileInput, NinetyNinePercentNaN)
           << r << ", " << col;
 }
 
-// A wall whose coordinates span most of float's range: every intermediate (extent,
-// voxel size, areas) must stay finite. One segment, every point labeled.
+// A wall whose coordinates span a large part of float's range: every intermediate
+// (extent, voxel size, areas) and every output must stay finite. One segment, every
+// point labeled. Twice as wide, the wall is one octree leaf (it is flat) whose size,
+// a power of two times the finest voxel, exceeds float's largest value: refused, not
+// given with an infinite leaf.
 TEST(HostileInput, CoordinatesNearFloatLimits)
 {
   const float big = std::numeric_limits<float>::max();
-  for (const float z : {0.25f * big, 0.9f * big}) {
+  const auto wall_of = [&](float half_width, float z) {
     auto cloud = pcl::make_shared<Cloud>(200, 200);
     for (int r = 0; r < 200; ++r)
       for (int c = 0; c < 200; ++c)
-        cloud->at(c, r) = pcl::PointXYZ(0.45f * big * ((c - 100) / 100.0f),
-                                        0.45f * big * ((r - 100) / 100.0f),
-                                        z);
+        cloud->at(c, r) = pcl::PointXYZ(
+            half_width * ((c - 100) / 100.0f), half_width * ((r - 100) / 100.0f), z);
+    return cloud;
+  };
+  for (const float z : {0.25f * big, 0.9f * big}) {
+    const auto cloud = wall_of(0.2f * big, z);
     Segmented run(cloud);
     ASSERT_TRUE(run.ok) << z;
     EXPECT_EQ(run.seg.getResult().counts.labeled, cloud->size()) << z;
     EXPECT_EQ(run.clusters.size(), 1u) << z;
     EXPECT_TRUE(std::isfinite(run.seg.getResult().min_voxel_size)) << z;
+    for (const auto& leaf : run.seg.getResult().leaves) {
+      EXPECT_TRUE(std::isfinite(leaf.size)) << z;
+      EXPECT_TRUE(leaf.centre.allFinite()) << z;
+    }
+    Segmented wide(wall_of(0.45f * big, z));
+    EXPECT_FALSE(wide.ok) << z;
+    EXPECT_TRUE(wide.seg.getResult().leaves.empty()) << z;
   }
   // Denormal coordinates: the same wall, scaled down to 1e-40.
   auto tiny = wall(200, 200);

@@ -18,10 +18,22 @@
 #include <pcl/point_types.h>
 
 #include <algorithm>
+#include <mutex>
 #include <vector>
 
 namespace pcl {
 namespace selective_seg {
+
+namespace detail {
+/** \brief The mutex of a cache built in a const getter; a copy of its owner gets a
+ * mutex of its own. */
+struct CacheMutex {
+  CacheMutex() = default;
+  CacheMutex(const CacheMutex&) {}
+  CacheMutex& operator=(const CacheMutex&) { return *this; }
+  std::mutex mutex;
+};
+} // namespace detail
 
 struct MergeReplay; // region_merging.h
 
@@ -183,7 +195,7 @@ public:
   /** \brief Use the input cloud's sensor_origin_ / sensor_orientation_ again. */
   void resetSensorPose() { delaunay_.resetSensorPose(); }
   /** \brief The sensor pose of the last run (setSensorPose()'s, or the cloud's), which
-   * its results are in; before any run, the pose in use. */
+   * its results are in; before any run and after a failed one, the pose in use. */
   Eigen::Affine3f getSensorPose() const
   {
     return mesh_pose_.isZero() ? delaunay_.getSensorPose()
@@ -196,7 +208,10 @@ public:
    * \return false, with a PCL_ERROR saying why and empty outputs, on a missing or
    *         unusable input or an invalid parameter, and when memory runs out
    *         (std::bad_alloc is caught, on every thread of the parallel stages too;
-   *         the result is cleared; docs/reliability.md, "Out of memory"). */
+   *         the result is cleared; docs/reliability.md, "Out of memory"). After a
+   *         failure every getter is empty (the triangulation too), but for
+   *         getResult().counts, which keep the points the triangulation set aside
+   *         and why, as far as it got (the others are 0). */
   bool extract(std::vector<pcl::PointIndices>& clusters);
 
   /** \brief Fold more points of the same scene, seen from the same sensor pose, into
@@ -231,14 +246,18 @@ public:
    * unlabeled); same size, order and layout (width, height) as that cloud (one row
    * when its width x height is not its size). Null before a successful extract().
    * The getters describe the last extract() or update(), whatever the input, pose or
-   * parameters set since. */
+   * parameters set since. As in PCL's other classes, the run's cloud is not copied:
+   * this getter and getPolygonMesh() read its points through the pointer given to
+   * setInputCloud(), so call them before refilling that cloud in place for the next
+   * frame (a cloud of another size gives null and an empty mesh). The const getters
+   * may be called from several threads at once. */
   LabeledCloud::Ptr getLabeledCloud() const;
 
   /** \brief Point normals (eq. 2) in the cloud frame of the last run (its sensor
    * pose), oriented toward the sensor; same size and layout as getLabeledCloud(); NaN
    * where a point has no normal. Null before a successful extract(). Built from the
    * vertex normals on the first call after a run (the pipeline itself needs only the
-   * vertex normals), then kept. */
+   * vertex normals), then kept: every call after a run gives the same cloud. */
   NormalCloud::ConstPtr getPointNormals() const;
 
   /** \brief The segmented mesh over the last run's input cloud (labels and classes
@@ -247,8 +266,8 @@ public:
 
   /** \brief The triangulation of the last extract() or update(): the vertex of every
    * input point, the vertices' representative points, angles and sensor-frame
-   * positions. Its neighbours are left empty: the triangle adjacency is
-   * getResult().mesh.neighbours (same triangle order), stored once. */
+   * positions; empty after a failed run. Its neighbours are left empty: the triangle
+   * adjacency is getResult().mesh.neighbours (same triangle order), stored once. */
   const SphericalTriangulation& getTriangulation() const
   {
     return delaunay_.getTriangulation();
@@ -337,6 +356,9 @@ protected:
   /** \brief Fail after std::bad_alloc: report, clear the outputs and what update()
    * would fold into. */
   bool failOutOfMemory(const char* stage);
+  /** \brief After a failed run: the triangulation emptied and the run's pose
+   * forgotten, so that no getter describes an earlier run. */
+  void forgetRun();
   /** \brief extract() but for its handling of std::bad_alloc. */
   bool runExtract(std::vector<pcl::PointIndices>& clusters);
   /** \brief update() from the union of the input and \a new_points on, but for its
@@ -371,6 +393,7 @@ private:
   SphericalDelaunay<PointT> delaunay_;
   typename Octree::Ptr octree_;
   mutable NormalCloud::ConstPtr normals_; ///< built by getPointNormals()
+  mutable detail::CacheMutex normals_mutex_;
   Vector3fVector vertex_normals_;         ///< sensor frame
   std::shared_ptr<std::vector<double>> vertex_areas_;
   Vector3fVector triangle_normals_;

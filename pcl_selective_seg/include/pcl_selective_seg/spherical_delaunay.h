@@ -195,6 +195,10 @@ public:
   /** \brief The triangulation of the last reconstruct() or triangulate() call. */
   const SphericalTriangulation& getTriangulation() const { return triangulation_; }
 
+  /** \brief Empty the triangulation and free its memory (a user of it whose run
+   * failed). */
+  void clearTriangulation() { triangulation_ = SphericalTriangulation(); }
+
 protected:
   /** \brief After initCompute(): false, with a PCL_ERROR, when the indices standing
    * for the whole cloud are fewer than its points (PCLBase::initCompute() goes on

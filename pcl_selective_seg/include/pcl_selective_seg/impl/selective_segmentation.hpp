@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <new>
 #include <numeric>
@@ -64,6 +65,7 @@ SelectiveSegmentation<PointT>::fail(const char* stage, const std::string& why)
   result_.counts = counts;
   octree_.reset();
   normals_.reset();
+  forgetRun();
   this->deinitCompute();
   return false;
 }
@@ -77,6 +79,7 @@ SelectiveSegmentation<PointT>::failOutOfMemory(const char* stage)
   previous_leaves_ = typename Octree::PreviousLeaves();
   previous_merge_ = PreviousMerge();
   mesh_input_.reset();
+  forgetRun();
   PCL_ERROR("[pcl::selective_seg::%s::%s] out of memory with %zu input points: "
             "segment fewer (setIndices(), a voxel grid filter) or give the process "
             "more memory\n",
@@ -85,6 +88,14 @@ SelectiveSegmentation<PointT>::failOutOfMemory(const char* stage)
             points);
   this->deinitCompute();
   return false;
+}
+
+template <typename PointT>
+void
+SelectiveSegmentation<PointT>::forgetRun()
+{
+  delaunay_.clearTriangulation();
+  mesh_pose_.setZero();
 }
 
 template <typename PointT>
@@ -352,6 +363,23 @@ SelectiveSegmentation<PointT>::buildOctree()
     return fail("extract",
                 "the octree holds no point: no point has a normal, or the octree "
                 "refused the points' extent (reason above)");
+  // The leaves' sizes and centres are floats (OctreeLeaf): near float's limits, a
+  // large leaf may not fit one.
+  const auto leaf_fits = [&](const AdaptiveLeaf& leaf) {
+    return octree_->getVoxelSideLength(leaf.depth) <=
+               std::numeric_limits<float>::max() &&
+           (delaunay_.getSensorPose() * octree_->getVoxelCentre(leaf)).allFinite();
+  };
+  const auto& fitting = octree_->getAdaptiveLeaves();
+  if (extent > 0.25 * std::numeric_limits<float>::max() &&
+      !std::all_of(fitting.begin(), fitting.end(), leaf_fits)) {
+    char span[32];
+    std::snprintf(span, sizeof(span), "%.3g", extent);
+    return fail("extract",
+                std::string("the points span ") + span +
+                    " m, more than the octree's float voxels hold: scale the cloud "
+                    "down (e.g. give it in kilometres)");
+  }
 
   detail::assignLarge(vertex_leaf_, num_vertices, -1);
   const auto& leaves = octree_->getAdaptiveLeaves();
@@ -688,6 +716,7 @@ SelectiveSegmentation<PointT>::runExtract(std::vector<pcl::PointIndices>& cluste
   mesh_input_.reset();
   pcl::StopWatch total;
   if (!initCompute()) {
+    forgetRun();
     this->deinitCompute();
     return false;
   }
@@ -780,6 +809,8 @@ template <typename PointT>
 typename SelectiveSegmentation<PointT>::NormalCloud::ConstPtr
 SelectiveSegmentation<PointT>::getPointNormals() const
 {
+  // Built once, whichever thread comes first.
+  const std::lock_guard<std::mutex> lock(normals_mutex_.mutex);
   if (normals_)
     return normals_;
   const SphericalTriangulation& tri = delaunay_.getTriangulation();
