@@ -95,8 +95,8 @@ printHelp(const char* program)
              "                           3-D boxes (cloud frame), priorities, steps; "
              "budget flags below\n\n");
   print_info("Input and sensor:\n"
-             "  -unit_scale X            multiply coordinates by X, e.g. 0.01 for "
-             "centimetres (default 1)\n"
+             "  -unit_scale X            multiply coordinates (and the VIEWPOINT's "
+             "position) by X, e.g. 0.01 for centimetres (default 1)\n"
              "  -sensor_origin X,Y,Z     sensor position in the cloud frame [m] "
              "(default: the file's VIEWPOINT)\n"
              "  -sensor_orientation W,X,Y,Z  sensor orientation quaternion (default: "
@@ -144,6 +144,13 @@ findInput(int argc, char** argv, std::string& input)
         print_error("Option %s needs a value (see -h).\n", argv[i - 1]);
         return false;
       }
+      // A value that is one of the options was most likely forgotten (-json -o F).
+      if (kind == 1 && argv[i][0] == '-' && optionKind(argv[i]) >= 0) {
+        print_error("Option %s needs a value, not the option '%s' (see -h).\n",
+                    argv[i - 1],
+                    argv[i]);
+        return false;
+      }
       continue;
     }
     positional.emplace_back(argv[i]);
@@ -153,24 +160,6 @@ findInput(int argc, char** argv, std::string& input)
     return false;
   }
   input = positional.front();
-  return true;
-}
-
-bool
-parseVector(
-    int argc, char** argv, const char* flag, std::size_t n, std::vector<double>& v)
-{
-  if (find_argument(argc, argv, flag) < 0)
-    return true;
-  if (parse_x_arguments(argc, argv, flag, v) < 0 || v.size() != n) {
-    print_error("Option %s needs %zu comma-separated numbers.\n", flag, n);
-    return false;
-  }
-  for (const double x : v)
-    if (!std::isfinite(x)) {
-      print_error("Option %s needs finite numbers.\n", flag);
-      return false;
-    }
   return true;
 }
 
@@ -238,21 +227,38 @@ parseOptions(int argc, char** argv, Options& opt)
       !selseg_apps::optionsGivenOnce(
           argc, argv, [](const std::string& arg) { return optionKind(arg) == 1; }))
     return kUsageError;
-  parse_argument(argc, argv, "-o", opt.labels);
-  parse_argument(argc, argv, "-mesh_ply", opt.mesh_ply);
-  parse_argument(argc, argv, "-mesh_vtk", opt.mesh_vtk);
-  parse_argument(argc, argv, "-leaves", opt.leaves);
-  parse_argument(argc, argv, "-json", opt.json);
-  parse_argument(argc, argv, "-roi_json", opt.roi_json);
+  for (const auto& [flag, name] : {std::make_pair("-o", &opt.labels),
+                                   std::make_pair("-mesh_ply", &opt.mesh_ply),
+                                   std::make_pair("-mesh_vtk", &opt.mesh_vtk),
+                                   std::make_pair("-leaves", &opt.leaves),
+                                   std::make_pair("-json", &opt.json),
+                                   std::make_pair("-roi_json", &opt.roi_json)})
+    if (!selseg_apps::parseFileName(argc, argv, flag, *name))
+      return kUsageError;
   opt.ignore_viewpoint = find_switch(argc, argv, "-ignore_viewpoint");
   if (!outputsDistinct(opt))
     return kUsageError;
   if (!selseg_apps::parseNumber(argc, argv, "-unit_scale", opt.unit_scale) ||
       !selseg_apps::unitScaleUsable(opt.unit_scale) ||
-      !parseVector(argc, argv, "-sensor_origin", 3, opt.sensor_origin) ||
-      !parseVector(argc, argv, "-sensor_orientation", 4, opt.sensor_orientation) ||
+      !selseg_apps::parseNumberList(
+          argc, argv, "-sensor_origin", 3, opt.sensor_origin) ||
+      !selseg_apps::parseNumberList(
+          argc, argv, "-sensor_orientation", 4, opt.sensor_orientation) ||
       !orientationUsable(opt.sensor_orientation))
     return kUsageError;
+  for (const double x : opt.sensor_origin)
+    if (!(std::abs(x) <= std::numeric_limits<float>::max())) {
+      print_error("Option -sensor_origin needs coordinates within float's range "
+                  "(+-3.4e38).\n");
+      return kUsageError;
+    }
+  if (opt.ignore_viewpoint &&
+      (!opt.sensor_origin.empty() || !opt.sensor_orientation.empty())) {
+    print_error(
+        "-ignore_viewpoint puts the sensor at the origin looking along +z: give "
+        "it or -sensor_origin / -sensor_orientation, not both.\n");
+    return kUsageError;
+  }
   if (!selseg_apps::parseSegmentationOptions(argc, argv, opt.params) ||
       !selseg_apps::parseRegionOptions(argc, argv, opt.roi))
     return kUsageError;
@@ -432,6 +438,18 @@ segment(const Options& opt)
   timer.tic();
   auto cloud = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
   std::string error;
+  // The outputs are checked before the work that makes them (a folder, a missing
+  // folder, a FIFO), as the viewer and the simulator check theirs.
+  for (const std::string* path : {&opt.labels,
+                                  &opt.mesh_ply,
+                                  &opt.mesh_vtk,
+                                  &opt.leaves,
+                                  &opt.json,
+                                  &opt.roi_json})
+    if (!path->empty() && !selseg_apps::outputWritable(*path, error)) {
+      print_error("%s\n", error.c_str());
+      return kRuntimeError;
+    }
   // The heap for the whole run at once, in huge pages (when the tool keeps its freed
   // memory): sized by the points a PCD or PLY header declares, before they are read,
   // or by the points read from a text file.
@@ -462,18 +480,35 @@ segment(const Options& opt)
     pose.translation() = cloud->sensor_origin_.head<3>();
     pose.linear() = cloud->sensor_orientation_.normalized().toRotationMatrix();
   }
+  if (!pose.matrix().allFinite()) {
+    print_error("The sensor pose has a value that is not a finite number (the file's "
+                "VIEWPOINT?): fix it, or give -sensor_origin and -sensor_orientation, "
+                "or -ignore_viewpoint.\n");
+    return kRuntimeError;
+  }
   seg.setInputCloud(cloud);
   std::vector<pcl::PointIndices> segments;
   if (!seg.extract(segments)) {
     const auto& c = seg.getResult().counts;
+    const bool panoramic =
+        opt.params.projection == pcl::selective_seg::ViewProjection::Panoramic;
+    // -ignore_viewpoint is worth suggesting only where it would change the pose.
+    const bool camera_frame = pose.matrix().isIdentity(0.0);
     if (c.behind_sensor > 0 && c.behind_sensor + c.non_finite == cloud->size())
-      print_error(
-          opt.params.projection == pcl::selective_seg::ViewProjection::Panoramic
-              ? "Every point lies at the sensor's position; check the sensor "
-                "origin (-sensor_origin, the file's VIEWPOINT).\n"
-              : "Every point lies behind the sensor pose; if the cloud is in the "
-                "camera frame (z forward), pass -ignore_viewpoint, or for a "
-                "sensor that sees all around -projection panoramic.\n");
+      print_error(panoramic ? "Every point lies at the sensor's position; check the "
+                              "sensor origin (-sensor_origin, the file's VIEWPOINT).\n"
+                  : camera_frame
+                      ? "Every point lies behind the sensor (z <= 0 in its frame): "
+                        "give its pose (-sensor_origin, -sensor_orientation), or for a "
+                        "sensor that sees all around -projection panoramic.\n"
+                      : "Every point lies behind the sensor pose; if the cloud is in "
+                        "the camera frame (z forward), pass -ignore_viewpoint, or for "
+                        "a sensor that sees all around -projection panoramic.\n");
+    else if (c.behind_sensor > 0 && !panoramic)
+      print_error("%zu of the %zu points lie behind the sensor and were left out (see "
+                  "-sensor_origin, -ignore_viewpoint, -projection panoramic).\n",
+                  c.behind_sensor,
+                  cloud->size());
     print_error("Segmentation failed (reason above).\n");
     return kRuntimeError;
   }

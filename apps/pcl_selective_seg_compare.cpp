@@ -28,6 +28,7 @@
 #include <pcl/segmentation/region_growing.h>
 #include <pcl/segmentation/supervoxel_clustering.h>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -292,26 +293,29 @@ row(const std::string& scene,
   m::ObjectMetricsParams params;
   params.boundary_radius = params.boundary_match_distance = 0.02;
   m::objectMetrics(cloud, run.labels, truth, params, o);
+  // A scene with one ground-truth region has no boundary to recall: "-", not nan.
+  char recall[32] = "-";
+  if (std::isfinite(o.boundary.recall))
+    std::snprintf(recall, sizeof(recall), "%.2f", o.boundary.recall);
   char line[640];
-  std::snprintf(
-      line,
-      sizeof(line),
-      "| %s | %s | %.3f | %zu | %zu | %zu | %zu | %zu | %zu | %.2f%% | %.2f | "
-      "%zu | %.2f | %s |\n",
-      scene.c_str(),
-      method.c_str(),
-      run.seconds,
-      h.num_predicted_regions,
-      h.correct_detections,
-      h.over_segmentations,
-      h.under_segmentations,
-      h.missed,
-      h.noise,
-      100.0 * o.under_segmentation.error,
-      o.boundary.recall,
-      o.coverage.segments,
-      o.parts.fraction,
-      correct_by_tolerance.c_str());
+  std::snprintf(line,
+                sizeof(line),
+                "| %s | %s | %.3f | %zu | %zu | %zu | %zu | %zu | %zu | %.2f%% | %s | "
+                "%zu | %.2f | %s |\n",
+                scene.c_str(),
+                method.c_str(),
+                run.seconds,
+                h.num_predicted_regions,
+                h.correct_detections,
+                h.over_segmentations,
+                h.under_segmentations,
+                h.missed,
+                h.noise,
+                100.0 * o.under_segmentation.error,
+                recall,
+                o.coverage.segments,
+                o.parts.fraction,
+                correct_by_tolerance.c_str());
   return line;
 }
 

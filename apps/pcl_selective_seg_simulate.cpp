@@ -317,6 +317,11 @@ run(int argc, char** argv)
     return kRuntimeError;
   print_info("[done, %g ms : %zu points]\n", timer.toc(), cloud.size());
   printCounts(setup.scene, cloud, details);
+  if (cloud.empty() && !opt.output.empty()) { // a file no tool reads
+    print_error("No ray returned a point: lower -dropout or -holes / -hole_radius_deg "
+                "(nothing written).\n");
+    return kRuntimeError;
+  }
   if (!opt.output.empty() && !saveCloud(opt.output, cloud))
     return kRuntimeError;
   if (!opt.output.empty())

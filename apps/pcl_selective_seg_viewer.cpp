@@ -129,8 +129,8 @@ printHelp(const char* program)
       "Usage: %s input.{pcd,ply,xyz,txt} [options]\n\n",
       program);
   print_info("Input:\n");
-  print_info("  -unit_scale X          factor applied to the coordinates, e.g. 0.001 "
-             "for millimetres [-] (default %g)\n",
+  print_info("  -unit_scale X          factor applied to the coordinates and the "
+             "VIEWPOINT's position, e.g. 0.001 for millimetres [-] (default %g)\n",
              d.unit_scale);
   print_info("  -ignore_viewpoint      sensor at the origin looking along +z, whatever "
              "the file's VIEWPOINT says (default off)\n");

@@ -1,5 +1,5 @@
 # ctest driver (cmake -P): pcl_selective_seg_simulate's exit codes and messages on usage
-# errors and unwritable outputs. Only the last output case simulates a scan (the cube,
+# errors and unwritable outputs. Only the last output cases simulate a scan (the cube,
 # a few milliseconds).
 #   -DSIMULATE=<the simulator tool> -DWORK=<a scratch folder, emptied first>
 if(NOT DEFINED SIMULATE)
@@ -48,6 +48,11 @@ if(DEFINED WORK)
   expect(0 "" -o ${WORK}/cube.pcd)
   if(NOT EXISTS ${WORK}/cube.pcd)
     set(failures "${failures}\n  -o ${WORK}/cube.pcd wrote nothing")
+  endif()
+  # Every ray dropped: an empty cloud, which no tool reads, was written with exit 0.
+  expect(1 "No ray returned a point" -dropout 0.999999 -o ${WORK}/none.pcd)
+  if(EXISTS ${WORK}/none.pcd)
+    set(failures "${failures}\n  an empty simulation wrote ${WORK}/none.pcd")
   endif()
   file(REMOVE_RECURSE ${WORK})
 endif()

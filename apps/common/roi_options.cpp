@@ -194,28 +194,10 @@ parseRegionOptions(int argc,
       pcl::console::print_error("Option %s needs a whole number >= 0.\n", flag);
       return false;
     }
-  if (pcl::console::find_argument(argc, argv, "-roi_weights") >= 0) {
-    // Each value read whole and finite (pcl::console's atof read "a" as 0).
-    std::string text;
-    pcl::console::parse_argument(argc, argv, "-roi_weights", text);
-    std::vector<double> w;
-    bool numbers = true;
-    std::size_t begin = 0;
-    while (numbers && begin <= text.size()) {
-      const std::size_t end = std::min(text.find(',', begin), text.size());
-      const std::string item = text.substr(begin, end - begin);
-      char* stop = nullptr;
-      const double value = std::strtod(item.c_str(), &stop);
-      numbers =
-          !item.empty() && stop == item.c_str() + item.size() && std::isfinite(value);
-      w.push_back(value);
-      begin = end + 1;
-    }
-    if (!numbers || w.size() != 5) {
-      pcl::console::print_error(
-          "Option -roi_weights needs 5 comma-separated numbers.\n");
-      return false;
-    }
+  std::vector<double> w;
+  if (!parseNumberList(argc, argv, "-roi_weights", 5, w))
+    return false;
+  if (!w.empty()) {
     p.transition_weight = w[0];
     p.leaf_weight = w[1];
     p.valid_edge_weight = w[2];
@@ -242,6 +224,11 @@ parseRegionOptions(int argc,
   p.max_window_size = max_window * kDeg;
   p.min_window_size = min_window * kDeg;
   p.margin = margin * kDeg;
+  if (sigma < 0.0) { // the library reads any value <= 0 as off: one way to say it
+    pcl::console::print_error(
+        "Option -roi_leaf_sigma_deg needs 0 (off) or a positive angle.\n");
+    return false;
+  }
   p.leaf_sigma_threshold = sigma * kDeg;
   p.min_side_angle = side * kDeg;
   p.edge_on_angle = edge_on * kDeg;

@@ -13,10 +13,14 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <set>
 #include <sstream>
 #include <vector>
@@ -82,6 +86,13 @@ coordinateFieldsUsable(const std::string& path,
     return false;
   }
   for (const char* name : {"x", "y", "z"}) {
+    // Two fields of one name: PCL reads the first; which one was meant is a guess.
+    if (std::count_if(blob.fields.begin(), blob.fields.end(), [&](const auto& f) {
+          return f.name == name;
+        }) > 1) {
+      error = "'" + path + "' has more than one field " + name + ": give each once";
+      return false;
+    }
     const auto& f = blob.fields[pcl::getFieldIndex(blob, name)];
     if ((f.datatype != pcl::PCLPointField::FLOAT32 &&
          f.datatype != pcl::PCLPointField::FLOAT64) ||
@@ -383,6 +394,72 @@ pcdHeaderUsable(const std::string& path,
   return coordinateFieldsUsable(path, header, error);
 }
 
+/** The names PCL's PLY reader treats as colour when their type is uchar. */
+bool
+isPlyColourName(const std::string& name)
+{
+  const std::string base = name.rfind("diffuse_", 0) == 0 ? name.substr(8) : name;
+  return base == "red" || base == "green" || base == "blue" || name == "alpha";
+}
+
+/** PCL's PLY reader makes a colour field at `red` and writes it at `blue`, moving on
+ * only then; `green`, `blue` or `alpha` anywhere else write over other fields or past
+ * the point (an assertion then aborts the process). So the uchar colour properties of
+ * the vertices, each given as (position, name), must be none, or `red green blue`
+ * (or their `diffuse_` names) one after the other, perhaps followed by `alpha`. */
+bool
+plyColoursUsable(const std::vector<std::pair<std::size_t, std::string>>& colours)
+{
+  if (colours.empty())
+    return true;
+  if (colours.size() != 3 && colours.size() != 4)
+    return false;
+  const std::string prefix = colours[0].second == "diffuse_red" ? "diffuse_" : "";
+  const char* names[] = {"red", "green", "blue", "alpha"};
+  for (std::size_t k = 0; k < colours.size(); ++k)
+    if (colours[k].first != colours[0].first + k ||
+        colours[k].second != (k < 3 ? prefix + names[k] : std::string(names[k])))
+      return false;
+  return true;
+}
+
+/** An ASCII PLY's vertex lines, after \a skip lines of earlier elements, each start
+ * with \a properties numbers (PCL's reader makes a word a NaN coordinate, silently):
+ * false with the line's number otherwise. \a in is at the first line after the
+ * header. */
+bool
+plyAsciiVerticesAreNumbers(std::istream& in,
+                           unsigned long long skip,
+                           long long vertices,
+                           std::size_t properties,
+                           const std::string& what,
+                           std::string& error)
+{
+  std::string line;
+  for (unsigned long long k = 0; k < skip; ++k)
+    if (!std::getline(in, line))
+      return true; // short: PCL's reader says so
+  for (long long v = 0; v < vertices && std::getline(in, line); ++v) {
+    std::istringstream words(line);
+    std::string word;
+    for (std::size_t p = 0; p < properties; ++p) {
+      const bool read = static_cast<bool>(words >> word);
+      char* end = nullptr;
+      if (read)
+        std::strtod(word.c_str(), &end);
+      if (!read || end != word.c_str() + word.size()) {
+        error = what + "vertex " + std::to_string(v) + " (line " +
+                std::to_string(skip + static_cast<unsigned long long>(v) + 1) +
+                " after the header) has " +
+                (read ? "'" + word.substr(0, 40) + "' where a number should be"
+                      : "fewer than its " + std::to_string(properties) + " values");
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
 /** Checks a PLY header line by line before PCL reads it (its parser trusts the header:
  * a negative element count sends it into a loop of about 2^64 steps) and counts the
  * values its elements promise. PCL also takes `obj_info num_cols N` / `num_rows N` as
@@ -403,7 +480,15 @@ plyHeaderUsable(const std::string& path,
   }
   unsigned long long values = 0;
   long long count = 0, vertices = -1, cols = -1, rows = -1;
-  bool in_element = false;
+  bool in_element = false, in_vertex = false;
+  // The vertex element's one-byte colour properties, with their positions among its
+  // properties.
+  std::vector<std::pair<std::size_t, std::string>> colours;
+  std::size_t vertex_properties = 0;
+  // ASCII: one line per element item, the vertices after the items of the elements
+  // declared before them.
+  bool ascii = false, vertex_has_list = false, vertex_seen = false;
+  unsigned long long lines_before_vertices = 0;
   while (std::getline(in, line)) {
     // PCL's PLY reader splits some lines at spaces and tabs only and asserts on what it
     // finds: no leading white space, no control characters but a final CR.
@@ -418,6 +503,12 @@ plyHeaderUsable(const std::string& path,
     std::string keyword;
     words >> keyword;
     if (keyword == "end_header") {
+      if (!plyColoursUsable(colours)) {
+        error = what + "its vertex colours are not the properties red, green, blue " +
+                "(uchar, one after the other, then alpha or not) that PCL's PLY " +
+                "reader needs: reorder or drop them (e.g. save it as PCD)";
+        return false;
+      }
       if ((cols >= 0 || rows >= 0) &&
           (cols < 0 || rows < 0 || cols * rows != vertices)) {
         error = what + "its obj_info num_cols (" + std::to_string(cols) +
@@ -427,7 +518,10 @@ plyHeaderUsable(const std::string& path,
         return false;
       }
       declared_points = static_cast<unsigned long long>(std::max(vertices, 0ll));
-      return plausibleSize(path, values, bytesAfter(path, in.tellg()), error);
+      return plausibleSize(path, values, bytesAfter(path, in.tellg()), error) &&
+             (!ascii || vertex_has_list ||
+              plyAsciiVerticesAreNumbers(
+                  in, lines_before_vertices, vertices, vertex_properties, what, error));
     }
     if (keyword == "comment")
       continue;
@@ -448,6 +542,7 @@ plyHeaderUsable(const std::string& path,
       ok = static_cast<bool>(words >> format >> version) &&
            (format == "ascii" || format == "binary_little_endian" ||
             format == "binary_big_endian");
+      ascii = format == "ascii";
     } else if (keyword == "element") {
       std::string name, rest;
       ok = static_cast<bool>(words >> name >> count) && !(words >> rest) &&
@@ -455,10 +550,20 @@ plyHeaderUsable(const std::string& path,
       if (ok && name == "vertex")
         vertices = count;
       in_element = true;
+      in_vertex = name == "vertex";
+      vertex_seen |= in_vertex;
+      if (ok && !vertex_seen)
+        lines_before_vertices += static_cast<unsigned long long>(count);
     } else if (keyword == "property" && in_element) {
       std::string type, name;
       ok = static_cast<bool>(words >> type >> name);
       values += static_cast<unsigned long long>(count);
+      if (ok && in_vertex) {
+        vertex_has_list |= type == "list";
+        if ((type == "uchar" || type == "uint8") && isPlyColourName(name))
+          colours.emplace_back(vertex_properties, name);
+        ++vertex_properties;
+      }
     }
     if (!ok) {
       error =
@@ -470,7 +575,8 @@ plyHeaderUsable(const std::string& path,
   return false;
 }
 
-/** x, y, z of every point of \a blob, converted from float32 or float64. */
+/** x, y, z of every point of \a blob, converted from float32 or float64; false when the
+ * conversion to float makes distinct points one. */
 bool
 extractXYZ(const std::string& path,
            const pcl::PCLPointCloud2& blob,
@@ -498,17 +604,62 @@ extractXYZ(const std::string& path,
   cloud.width = blob.width;
   cloud.height = blob.height;
   cloud.is_dense = false;
-  for (std::size_t i = 0; i < points; ++i)
-    for (int k = 0; k < 3; ++k) {
-      const std::uint8_t* at =
-          blob.data.data() + i * blob.point_step + fields[k]->offset;
-      if (fields[k]->datatype == pcl::PCLPointField::FLOAT64) {
-        double v;
-        std::memcpy(&v, at, sizeof v);
-        cloud[i].data[k] = static_cast<float>(v);
-      } else
-        std::memcpy(&cloud[i].data[k], at, sizeof(float));
+  const auto coordinate = [&](std::size_t i, int k) {
+    const std::uint8_t* at = blob.data.data() + i * blob.point_step + fields[k]->offset;
+    if (fields[k]->datatype == pcl::PCLPointField::FLOAT64) {
+      double v;
+      std::memcpy(&v, at, sizeof v);
+      return v;
     }
+    float v;
+    std::memcpy(&v, at, sizeof v);
+    return static_cast<double>(v);
+  };
+  bool any_double = false;
+  for (int k = 0; k < 3; ++k)
+    any_double |= fields[k]->datatype == pcl::PCLPointField::FLOAT64;
+  for (std::size_t i = 0; i < points; ++i)
+    for (int k = 0; k < 3; ++k)
+      cloud[i].data[k] = static_cast<float>(coordinate(i, k));
+  if (!any_double)
+    return true;
+  // Coordinates far from the origin (georeferenced scans) lose their last digits in
+  // float, and points a few millimetres apart become one: refuse rather than segment
+  // what is left.
+  std::vector<std::size_t> order;
+  for (std::size_t i = 0; i < points; ++i)
+    if (cloud[i].getVector3fMap().allFinite())
+      order.push_back(i);
+  const auto float_less = [&](std::size_t a, std::size_t b) {
+    const auto& p = cloud[a].data;
+    const auto& q = cloud[b].data;
+    return std::lexicographical_compare(p, p + 3, q, q + 3);
+  };
+  std::sort(order.begin(), order.end(), float_less);
+  std::size_t merged = 0;
+  double largest = 0.0;
+  for (std::size_t j = 0; j < order.size(); ++j) {
+    for (int k = 0; k < 3; ++k)
+      largest = std::max(largest, std::abs(coordinate(order[j], k)));
+    if (j == 0 || float_less(order[j - 1], order[j]))
+      continue;
+    for (int k = 0; k < 3; ++k)
+      if (coordinate(order[j - 1], k) != coordinate(order[j], k)) {
+        ++merged;
+        break;
+      }
+  }
+  if (merged > 0) {
+    char size[32];
+    std::snprintf(size, sizeof(size), "%.6g", largest);
+    error = "cannot segment '" + path + "' as it is: " + std::to_string(merged) +
+            " of its distinct points (double coordinates) become the same float point "
+            "(coordinates up to " +
+            size +
+            " from the origin keep too few digits in float): move the points near the "
+            "origin first (subtract the sensor position or the scan's centre)";
+    return false;
+  }
   return true;
 }
 
@@ -605,6 +756,8 @@ loadBinaryFormat(const std::string& path,
     rc = ext == ".pcd"
              ? pcl::PCDReader().read(path, blob, origin, orientation, version)
              : pcl::PLYReader().read(path, blob, origin, orientation, version);
+  } catch (const std::bad_alloc&) {
+    throw; // out of memory, not a corrupt file: guardedLoad() says so
   } catch (const std::exception& e) { // PCL's readers throw on some corrupt files
     rc = -1;
   }
@@ -619,6 +772,26 @@ loadBinaryFormat(const std::string& path,
   cloud.sensor_origin_ = origin;
   cloud.sensor_orientation_ = orientation;
   return true;
+}
+
+/** \a word as a float coordinate of a text scan: empty when it is one (nan and inf
+ * included: such points are counted and left unlabeled), else what is wrong. */
+std::string
+textCoordinate(const std::string& word, float& value)
+{
+  if (word.empty())
+    return "expected three numbers 'x y z'";
+  char* end = nullptr;
+  errno = 0;
+  const double v = std::strtod(word.c_str(), &end);
+  if (end != word.c_str() + word.size())
+    return "'" + word + "' is not a number (expected three numbers 'x y z')";
+  if ((errno == ERANGE && std::isinf(v)) ||
+      (std::isfinite(v) && std::abs(v) > std::numeric_limits<float>::max()))
+    return "'" + word + "' is beyond float's range (+-3.4e38): give the points in a " +
+           "larger unit";
+  value = static_cast<float>(v);
+  return {};
 }
 
 bool
@@ -639,13 +812,17 @@ loadText(const std::string& path,
     if (first == std::string::npos || line[first] == '#')
       continue;
     std::istringstream fields(line);
-    float x, y, z;
-    if (!(fields >> x >> y >> z)) {
-      error = "'" + path + "' line " + std::to_string(line_number) +
-              ": expected three numbers 'x y z'";
-      return false;
+    std::string word[3];
+    fields >> word[0] >> word[1] >> word[2];
+    pcl::PointXYZ p;
+    for (int k = 0; k < 3; ++k) {
+      const std::string why = textCoordinate(word[k], p.data[k]);
+      if (!why.empty()) {
+        error = "'" + path + "' line " + std::to_string(line_number) + ": " + why;
+        return false;
+      }
     }
-    cloud.push_back(pcl::PointXYZ(x, y, z));
+    cloud.push_back(p);
   }
   if (cloud.empty()) {
     error = "'" + path + "' holds no 'x y z' line";
@@ -693,9 +870,12 @@ loadScan(const std::string& path,
     cloud.clear();
     return false;
   }
-  if (unit_scale != 1.0)
+  if (unit_scale != 1.0) {
     for (auto& p : cloud)
       p.getVector3fMap() *= static_cast<float>(unit_scale);
+    // The file's VIEWPOINT is a position in the same unit.
+    cloud.sensor_origin_.head<3>() *= static_cast<float>(unit_scale);
+  }
   return true;
 }
 

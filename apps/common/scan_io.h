@@ -33,7 +33,8 @@ using DeclaredPointsHook = std::function<void(std::size_t)>;
  * The PCD's VIEWPOINT becomes the cloud's sensor_origin_ / sensor_orientation_; the
  * organized layout (width x height) is kept.
  * \param[in] path the file; its extension (.pcd, .ply, anything else = text) decides
- * \param[in] unit_scale factor applied to every coordinate (0.01 for centimetres)
+ * \param[in] unit_scale factor applied to every coordinate and to the VIEWPOINT's
+ * position (0.01 for centimetres)
  * \param[out] cloud the points, in input order
  * \param[out] error what is wrong with the file and what to do, when false
  * \param[in] before_reading if set, called with the points a PCD or PLY header declares

@@ -7,6 +7,10 @@
 #include "segmentation_options.h"
 
 #include <cctype>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
 #include <set>
 
 namespace selseg_apps {
@@ -120,6 +124,101 @@ std::string
 choiceName(ViewProjection value)
 {
   return nameIn(kProjections, value);
+}
+
+bool
+readOptionNumber(const char* flag,
+                 const char* text,
+                 bool whole,
+                 double lowest,
+                 double highest,
+                 double& value)
+{
+  if (!text || text[0] == '\0') {
+    print_error("Option %s needs a value (see -h).\n", flag);
+    return false;
+  }
+  char* end = nullptr;
+  errno = 0;
+  const double v = std::strtod(text, &end);
+  if (end == text || *end != '\0' || std::isnan(v)) {
+    print_error("Option %s needs a number, not '%s' (see -h).\n", flag, text);
+    return false;
+  }
+  if ((errno == ERANGE && std::isinf(v)) || !(v >= lowest && v <= highest)) {
+    if (highest < std::numeric_limits<double>::max())
+      print_error("Option %s %s is out of range: give a number in [%g, %g] (see -h).\n",
+                  flag,
+                  text,
+                  lowest,
+                  highest);
+    else
+      print_error("Option %s %s is beyond a double's range (see -h).\n", flag, text);
+    return false;
+  }
+  if (whole && v != std::floor(v)) {
+    print_error("Option %s needs a whole number, not '%s' (see -h).\n", flag, text);
+    return false;
+  }
+  value = v; // a denormal (strtod's ERANGE towards 0) is a number like any other
+  return true;
+}
+
+bool
+parseNumberList(
+    int argc, char** argv, const char* flag, std::size_t n, std::vector<double>& values)
+{
+  const int at = pcl::console::find_argument(argc, argv, flag);
+  if (at < 0)
+    return true;
+  const std::string text = at + 1 < argc ? argv[at + 1] : "";
+  std::vector<double> read;
+  bool numbers = true;
+  for (std::size_t begin = 0; numbers && begin <= text.size();) {
+    const std::size_t end = std::min(text.find(',', begin), text.size());
+    const std::string item = text.substr(begin, end - begin);
+    char* stop = nullptr;
+    errno = 0;
+    const double value = std::strtod(item.c_str(), &stop);
+    numbers = !item.empty() && stop == item.c_str() + item.size() &&
+              std::isfinite(value) && errno != ERANGE;
+    read.push_back(value);
+    begin = end + 1;
+  }
+  if (!numbers || read.size() != n) {
+    print_error("Option %s needs %zu comma-separated finite numbers, not '%s' (see "
+                "-h).\n",
+                flag,
+                n,
+                text.c_str());
+    return false;
+  }
+  values = read;
+  return true;
+}
+
+bool
+parseFileName(int argc, char** argv, const char* flag, std::string& name)
+{
+  const int at = pcl::console::find_argument(argc, argv, flag);
+  if (at < 0)
+    return true;
+  const std::string text = at + 1 < argc ? argv[at + 1] : "";
+  if (text.empty()) {
+    print_error("Option %s needs a file name (see -h).\n", flag);
+    return false;
+  }
+  if (text.size() > 1 && text[0] == '-' &&
+      (std::isalpha(static_cast<unsigned char>(text[1])) || text[1] == '-')) {
+    print_error("Option %s needs a file name, not the option '%s'; a file whose name "
+                "starts with '-' is given as ./%s.\n",
+                flag,
+                text.c_str(),
+                text.c_str());
+    return false;
+  }
+  name = text;
+  return true;
 }
 
 bool

@@ -11,17 +11,29 @@
 #include <pcl/console/parse.h>
 #include <pcl/console/print.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
 
 namespace selseg_apps {
 
-/** \brief A checked number: absent is fine; present and not a finite number (an empty
- * value included) prints an error and returns false (pcl::console::parse_argument
- * alone would store 0). */
+/** \brief The value of option \a flag read as a number, whole when \a whole, in
+ * [\a lowest, \a highest]; false after printing what is wrong (no value, not a
+ * number, out of range, not whole). The whole text must be the number
+ * (pcl::console::parse_argument would read "a" as 0 and "5x" as 5). */
+bool readOptionNumber(const char* flag,
+                      const char* text,
+                      bool whole,
+                      double lowest,
+                      double highest,
+                      double& value);
+
+/** \brief A checked number: absent is fine; present and not a finite number of \a T's
+ * range (an empty value included) prints an error and returns false. */
 template <typename T>
 bool
 parseNumber(int argc, char** argv, const char* flag, T& value)
@@ -29,14 +41,37 @@ parseNumber(int argc, char** argv, const char* flag, T& value)
   const int at = pcl::console::find_argument(argc, argv, flag);
   if (at < 0)
     return true;
-  if (at + 1 >= argc || argv[at + 1][0] == '\0' ||
-      pcl::console::parse_argument(argc, argv, flag, value) < 0 ||
-      !std::isfinite(static_cast<double>(value))) {
-    pcl::console::print_error("Option %s needs a number (see -h).\n", flag);
+  const bool whole = std::numeric_limits<T>::is_integer;
+  // Whole numbers within 1e15, exact in a double.
+  const double highest = whole ? std::min(1e15, double(std::numeric_limits<T>::max()))
+                               : double(std::numeric_limits<T>::max());
+  double v = 0.0;
+  if (!readOptionNumber(flag,
+                        at + 1 < argc ? argv[at + 1] : nullptr,
+                        whole,
+                        whole
+                            ? -std::min(1e15, -double(std::numeric_limits<T>::lowest()))
+                            : double(std::numeric_limits<T>::lowest()),
+                        highest,
+                        v))
     return false;
-  }
+  value = static_cast<T>(v);
   return true;
 }
+
+/** \brief Option \a flag's \a n comma-separated finite numbers: absent is fine (\a
+ * values untouched); otherwise false after printing an error unless there are
+ * exactly \a n, each read whole. */
+bool parseNumberList(int argc,
+                     char** argv,
+                     const char* flag,
+                     std::size_t n,
+                     std::vector<double>& values);
+
+/** \brief Option \a flag's file name: absent is fine (\a name untouched); an empty
+ * value, none, or an option in its place (-o -json) prints an error and returns false.
+ * A file whose name starts with '-' is given as ./-name. */
+bool parseFileName(int argc, char** argv, const char* flag, std::string& name);
 
 /** \brief Whether -h or --help stands as an option, for a tool whose every option
  * takes one value: at an odd position, not as another option's value (-o -h). */
