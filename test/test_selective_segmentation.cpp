@@ -1010,6 +1010,21 @@ TEST(SelectiveSegmentation, ExtentBeyondFloatIsRefusedNotInfinite)
   EXPECT_FALSE(ok);
   EXPECT_TRUE(clusters.empty());
   EXPECT_TRUE(seg.getResult().leaves.empty());
+
+  // A narrow V near float's largest depth: the extent is a fifth of float's range,
+  // but the octree's box reaches past it.
+  auto vee = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  for (int r = 0; r <= 20; ++r)
+    for (int c = 0; c <= 20; ++c)
+      vee->push_back(pcl::PointXYZ(0.1f * big * (c - 10) / 10.0f,
+                                   0.1f * big * (r - 10) / 10.0f,
+                                   big * (0.95f + 0.05f * std::abs(c - 10) / 10.0f)));
+  const bool vee_ok = segment<pcl::PointXYZ>(vee, seg, clusters);
+  for (const auto& leaf : seg.getResult().leaves) {
+    EXPECT_TRUE(std::isfinite(leaf.size));
+    EXPECT_TRUE(leaf.centre.allFinite());
+  }
+  EXPECT_EQ(vee_ok, !seg.getResult().leaves.empty());
 }
 
 TEST(SelectiveSegmentation, CloudWhoseLayoutIsNotItsSize)

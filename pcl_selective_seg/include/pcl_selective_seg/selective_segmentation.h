@@ -25,13 +25,47 @@ namespace pcl {
 namespace selective_seg {
 
 namespace detail {
-/** \brief The mutex of a cache built in a const getter; a copy of its owner gets a
- * mutex of its own. */
-struct CacheMutex {
-  CacheMutex() = default;
-  CacheMutex(const CacheMutex&) {}
-  CacheMutex& operator=(const CacheMutex&) { return *this; }
-  std::mutex mutex;
+/** \brief A value built on demand by const getters, under a mutex: readers on several
+ * threads build it once, and a copy of its owner (a const operation too) reads it
+ * under the same lock and gets a mutex of its own. */
+template <typename T> class LockedCache {
+public:
+  LockedCache() = default;
+  LockedCache(const LockedCache& other)
+      : value_(other.get())
+  {
+  }
+  LockedCache& operator=(const LockedCache& other)
+  {
+    if (this != &other) {
+      T value = other.get();
+      const std::lock_guard<std::mutex> lock(mutex_);
+      value_ = std::move(value);
+    }
+    return *this;
+  }
+  T get() const
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    return value_;
+  }
+  void reset()
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    value_ = T();
+  }
+  /** \brief The value; when empty, first make() under the lock. */
+  template <typename Make> T getOrMake(const Make& make) const
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    if (!value_)
+      value_ = make();
+    return value_;
+  }
+
+private:
+  mutable std::mutex mutex_;
+  mutable T value_{};
 };
 } // namespace detail
 
@@ -209,9 +243,10 @@ public:
    *         unusable input or an invalid parameter, and when memory runs out
    *         (std::bad_alloc is caught, on every thread of the parallel stages too;
    *         the result is cleared; docs/reliability.md, "Out of memory"). After a
-   *         failure every getter is empty (the triangulation too), but for
-   *         getResult().counts, which keep the points the triangulation set aside
-   *         and why, as far as it got (the others are 0). */
+   *         failure the run's outputs are empty (getResult(), the clouds, the mesh,
+   *         the octree, the triangulation), but for getResult().counts, which keep
+   *         the points the triangulation set aside and why, as far as it got (the
+   *         others are 0); getUpdateStatistics() describes the last update() call. */
   bool extract(std::vector<pcl::PointIndices>& clusters);
 
   /** \brief Fold more points of the same scene, seen from the same sensor pose, into
@@ -392,8 +427,7 @@ private:
   SelectiveSegmentationParameters params_;
   SphericalDelaunay<PointT> delaunay_;
   typename Octree::Ptr octree_;
-  mutable NormalCloud::ConstPtr normals_; ///< built by getPointNormals()
-  mutable detail::CacheMutex normals_mutex_;
+  detail::LockedCache<NormalCloud::ConstPtr> normals_; ///< built by getPointNormals()
   Vector3fVector vertex_normals_;         ///< sensor frame
   std::shared_ptr<std::vector<double>> vertex_areas_;
   Vector3fVector triangle_normals_;

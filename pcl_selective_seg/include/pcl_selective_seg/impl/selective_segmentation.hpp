@@ -370,8 +370,14 @@ SelectiveSegmentation<PointT>::buildOctree()
                std::numeric_limits<float>::max() &&
            (delaunay_.getSensorPose() * octree_->getVoxelCentre(leaf)).allFinite();
   };
+  // Checked only where some could not: a leaf's centre is within its points' largest
+  // coordinate plus the octree's box (at most twice the extent or the finest voxel)
+  // in each axis, moved by the pose.
+  const double largest = std::max(lo.abs().maxCoeff(), hi.abs().maxCoeff());
+  const double reach = std::sqrt(3.0) * (largest + 2.0 * (extent + resolution)) +
+                       delaunay_.getSensorPose().translation().norm();
   const auto& fitting = octree_->getAdaptiveLeaves();
-  if (extent > 0.25 * std::numeric_limits<float>::max() &&
+  if (!(reach < 0.5 * std::numeric_limits<float>::max()) &&
       !std::all_of(fitting.begin(), fitting.end(), leaf_fits)) {
     char span[32];
     std::snprintf(span, sizeof(span), "%.3g", extent);
@@ -810,27 +816,25 @@ typename SelectiveSegmentation<PointT>::NormalCloud::ConstPtr
 SelectiveSegmentation<PointT>::getPointNormals() const
 {
   // Built once, whichever thread comes first.
-  const std::lock_guard<std::mutex> lock(normals_mutex_.mutex);
-  if (normals_)
-    return normals_;
-  const SphericalTriangulation& tri = delaunay_.getTriangulation();
-  if (!mesh_input_ || result_.labels.size() != mesh_input_->size() ||
-      tri.point_vertex.size() != mesh_input_->size() || vertex_normals_.empty())
-    return nullptr;
-  const float nan = std::numeric_limits<float>::quiet_NaN();
-  auto normals = cloudShapedLikeTheRun<NormalCloud>(pcl::Normal(nan, nan, nan, nan));
-  normals->is_dense = false;
-  // The orientation of the run, whatever the pose is now.
-  const Eigen::Matrix3f to_cloud = mesh_pose_.template topLeftCorner<3, 3>();
-  for (std::size_t i = 0; i < mesh_input_->size(); ++i) {
-    const pcl::index_t v = tri.point_vertex[i];
-    if (v < 0 || !vertex_normals_[v].allFinite())
-      continue;
-    (*normals)[i].getNormalVector3fMap() = to_cloud * vertex_normals_[v];
-    (*normals)[i].curvature = 0.0f;
-  }
-  normals_ = normals;
-  return normals_;
+  return normals_.getOrMake([this]() -> typename NormalCloud::ConstPtr {
+    const SphericalTriangulation& tri = delaunay_.getTriangulation();
+    if (!mesh_input_ || result_.labels.size() != mesh_input_->size() ||
+        tri.point_vertex.size() != mesh_input_->size() || vertex_normals_.empty())
+      return nullptr;
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    auto normals = cloudShapedLikeTheRun<NormalCloud>(pcl::Normal(nan, nan, nan, nan));
+    normals->is_dense = false;
+    // The orientation of the run, whatever the pose is now.
+    const Eigen::Matrix3f to_cloud = mesh_pose_.template topLeftCorner<3, 3>();
+    for (std::size_t i = 0; i < mesh_input_->size(); ++i) {
+      const pcl::index_t v = tri.point_vertex[i];
+      if (v < 0 || !vertex_normals_[v].allFinite())
+        continue;
+      (*normals)[i].getNormalVector3fMap() = to_cloud * vertex_normals_[v];
+      (*normals)[i].curvature = 0.0f;
+    }
+    return normals;
+  });
 }
 
 template <typename PointT>
