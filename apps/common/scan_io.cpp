@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -23,6 +24,7 @@
 #include <limits>
 #include <set>
 #include <sstream>
+#include <system_error>
 #include <vector>
 
 namespace selseg_apps {
@@ -439,20 +441,32 @@ plyAsciiVerticesAreNumbers(std::istream& in,
   for (unsigned long long k = 0; k < skip; ++k)
     if (!std::getline(in, line))
       return true; // short: PCL's reader says so
+  const auto space = [](char c) { return std::isspace(static_cast<unsigned char>(c)); };
   for (long long v = 0; v < vertices && std::getline(in, line); ++v) {
-    std::istringstream words(line);
-    std::string word;
+    const char* at = line.c_str();
     for (std::size_t p = 0; p < properties; ++p) {
-      const bool read = static_cast<bool>(words >> word);
-      char* end = nullptr;
-      if (read)
-        std::strtod(word.c_str(), &end);
-      if (!read || end != word.c_str() + word.size()) {
+      while (*at && space(*at))
+        ++at;
+      const char* start = at;
+      while (*at && !space(*at))
+        ++at;
+      // from_chars: decimal as PCL's reader takes it (no hexadecimal, which strtod
+      // would read), nan and inf included; a leading '+' is PCL's too.
+      const char* digits = start < at && *start == '+' ? start + 1 : start;
+      double value = 0.0;
+      const auto parsed = std::from_chars(digits, at, value);
+      const bool number =
+          start < at && digits < at &&
+          (parsed.ec == std::errc() || parsed.ec == std::errc::result_out_of_range) &&
+          parsed.ptr == at;
+      if (!number) {
+        const std::string token(start, static_cast<std::size_t>(at - start));
         error = what + "vertex " + std::to_string(v) + " (line " +
                 std::to_string(skip + static_cast<unsigned long long>(v) + 1) +
                 " after the header) has " +
-                (read ? "'" + word.substr(0, 40) + "' where a number should be"
-                      : "fewer than its " + std::to_string(properties) + " values");
+                (!token.empty()
+                     ? "'" + token.substr(0, 40) + "' where a number should be"
+                     : "fewer than its " + std::to_string(properties) + " values");
         return false;
       }
     }
@@ -509,11 +523,15 @@ plyHeaderUsable(const std::string& path,
                 "reader needs: reorder or drop them (e.g. save it as PCD)";
         return false;
       }
+      // More cells than vertices: PCL's own writer declares the organized size of a
+      // cloud whose NaN points it left out; the reader fills what there is, and
+      // loadBinaryFormat() drops the layout. Fewer: PCL's reader writes past its data.
       if ((cols >= 0 || rows >= 0) &&
-          (cols < 0 || rows < 0 || cols * rows != vertices)) {
+          (cols < 0 || rows < 0 || cols * rows < vertices)) {
         error = what + "its obj_info num_cols (" + std::to_string(cols) +
                 ") and num_rows (" + std::to_string(rows) +
-                ") do not multiply to its " + std::to_string(std::max(vertices, 0ll)) +
+                ") are not both given or multiply to fewer than its " +
+                std::to_string(std::max(vertices, 0ll)) +
                 " vertices: the header is corrupt";
         return false;
       }
@@ -575,8 +593,8 @@ plyHeaderUsable(const std::string& path,
   return false;
 }
 
-/** x, y, z of every point of \a blob, converted from float32 or float64; false when the
- * conversion to float makes distinct points one. */
+/** x, y, z of every point of \a blob, converted from float32 or float64; false when
+ * float's rounding of doubles would distort the scan. */
 bool
 extractXYZ(const std::string& path,
            const pcl::PCLPointCloud2& blob,
@@ -624,40 +642,45 @@ extractXYZ(const std::string& path,
   if (!any_double)
     return true;
   // Coordinates far from the origin (georeferenced scans) lose their last digits in
-  // float, and points a few millimetres apart become one: refuse rather than segment
-  // what is left.
-  std::vector<std::size_t> order;
-  for (std::size_t i = 0; i < points; ++i)
-    if (cloud[i].getVector3fMap().allFinite())
-      order.push_back(i);
-  const auto float_less = [&](std::size_t a, std::size_t b) {
-    const auto& p = cloud[a].data;
-    const auto& q = cloud[b].data;
-    return std::lexicographical_compare(p, p + 3, q, q + 3);
-  };
-  std::sort(order.begin(), order.end(), float_less);
-  std::size_t merged = 0;
+  // float: refuse when float's rounding there reaches a tenth of the points' spacing
+  // (the median distance between consecutive distinct points, which scans store in
+  // scan order), rather than segment a distorted scan. Near-duplicates that float
+  // merges at a small distance from the origin are no reason to refuse.
   double largest = 0.0;
-  for (std::size_t j = 0; j < order.size(); ++j) {
-    for (int k = 0; k < 3; ++k)
-      largest = std::max(largest, std::abs(coordinate(order[j], k)));
-    if (j == 0 || float_less(order[j - 1], order[j]))
+  std::vector<double> steps;
+  bool first = true;
+  Eigen::Vector3d previous_point = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < points; ++i) {
+    if (!cloud[i].getVector3fMap().allFinite())
       continue;
-    for (int k = 0; k < 3; ++k)
-      if (coordinate(order[j - 1], k) != coordinate(order[j], k)) {
-        ++merged;
-        break;
-      }
+    const Eigen::Vector3d p(coordinate(i, 0), coordinate(i, 1), coordinate(i, 2));
+    largest = std::max(largest, p.cwiseAbs().maxCoeff());
+    if (!first) {
+      const double step = (p - previous_point).norm();
+      if (step > 0.0)
+        steps.push_back(step);
+    }
+    first = false;
+    previous_point = p;
   }
-  if (merged > 0) {
-    char size[32];
-    std::snprintf(size, sizeof(size), "%.6g", largest);
-    error = "cannot segment '" + path + "' as it is: " + std::to_string(merged) +
-            " of its distinct points (double coordinates) become the same float point "
-            "(coordinates up to " +
-            size +
-            " from the origin keep too few digits in float): move the points near the "
-            "origin first (subtract the sensor position or the scan's centre)";
+  if (steps.empty())
+    return true;
+  auto middle = steps.begin() + static_cast<std::ptrdiff_t>(steps.size() / 2);
+  std::nth_element(steps.begin(), middle, steps.end());
+  const double rounding = largest * 0.5 * std::numeric_limits<float>::epsilon();
+  if (rounding > 0.1 * *middle) {
+    char text[160];
+    std::snprintf(text,
+                  sizeof(text),
+                  "at %.6g from the origin float rounds coordinates by up to %.3g, "
+                  "more than a tenth of the points' spacing (%.3g)",
+                  largest,
+                  rounding,
+                  *middle);
+    error = "cannot segment '" + path +
+            "' as it is: its coordinates are doubles, and " + text +
+            ": move the points near the origin first (subtract the sensor " +
+            "position or the scan's centre)";
     return false;
   }
   return true;
@@ -765,6 +788,14 @@ loadBinaryFormat(const std::string& path,
     error = "cannot read '" + path + "' as " + (ext == ".pcd" ? "PCD" : "PLY") +
             ": check that the file exists, is readable and is not truncated";
     return false;
+  }
+  // A PLY layout of more cells than vertices (above): the vertices, one row.
+  if (ext == ".ply" &&
+      static_cast<unsigned long long>(blob.width) * blob.height > declared) {
+    blob.width = static_cast<std::uint32_t>(declared);
+    blob.height = 1;
+    blob.row_step = blob.point_step * blob.width;
+    blob.data.resize(static_cast<std::size_t>(blob.row_step));
   }
   if (!extractXYZ(path, blob, cloud, error) ||
       (labels && !extractLabels(path, blob, *labels, error)))

@@ -147,7 +147,8 @@ readOptionNumber(const char* flag,
   }
   if ((errno == ERANGE && std::isinf(v)) || !(v >= lowest && v <= highest)) {
     if (highest < std::numeric_limits<double>::max())
-      print_error("Option %s %s is out of range: give a number in [%g, %g] (see -h).\n",
+      print_error("Option %s %s is out of range: give a number in [%.15g, %.15g] (see "
+                  "-h).\n",
                   flag,
                   text,
                   lowest,
@@ -181,7 +182,7 @@ parseNumberList(
     errno = 0;
     const double value = std::strtod(item.c_str(), &stop);
     numbers = !item.empty() && stop == item.c_str() + item.size() &&
-              std::isfinite(value) && errno != ERANGE;
+              std::isfinite(value); // a denormal is a number
     read.push_back(value);
     begin = end + 1;
   }
