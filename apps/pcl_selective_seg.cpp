@@ -21,6 +21,7 @@
 #include <pcl/console/time.h>
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <cstring>
@@ -184,35 +185,43 @@ orientationUsable(const std::vector<double>& q)
   return false;
 }
 
+/** Each output option with its file name (empty when not given), of \a opt (const or
+ * not). */
+template <typename OptionsT>
+auto
+outputFiles(OptionsT& opt)
+{
+  return std::array{std::pair{"-o", &opt.labels},
+                    std::pair{"-mesh_ply", &opt.mesh_ply},
+                    std::pair{"-mesh_vtk", &opt.mesh_vtk},
+                    std::pair{"-leaves", &opt.leaves},
+                    std::pair{"-json", &opt.json},
+                    std::pair{"-roi_json", &opt.roi_json}};
+}
+
 /** Two outputs naming one file would silently keep only the last one; an output naming
  * the input would replace the scan. */
 bool
 outputsDistinct(const Options& opt)
 {
-  const std::vector<std::pair<const char*, std::string>> outputs = {
-      {"-o", opt.labels},
-      {"-mesh_ply", opt.mesh_ply},
-      {"-mesh_vtk", opt.mesh_vtk},
-      {"-leaves", opt.leaves},
-      {"-json", opt.json},
-      {"-roi_json", opt.roi_json}};
+  const auto outputs = outputFiles(opt);
   for (std::size_t i = 0; i < outputs.size(); ++i) {
-    if (outputs[i].second.empty())
+    if (outputs[i].second->empty())
       continue;
-    if (selseg_apps::samePath(outputs[i].second, opt.input)) {
+    if (selseg_apps::samePath(*outputs[i].second, opt.input)) {
       print_error("Option %s names the input file '%s': give another output name.\n",
                   outputs[i].first,
                   opt.input.c_str());
       return false;
     }
     for (std::size_t j = i + 1; j < outputs.size(); ++j)
-      if (!outputs[j].second.empty() &&
-          selseg_apps::samePath(outputs[i].second, outputs[j].second)) {
+      if (!outputs[j].second->empty() &&
+          selseg_apps::samePath(*outputs[i].second, *outputs[j].second)) {
         print_error("Options %s and %s name the same file '%s': give each output its "
                     "own name.\n",
                     outputs[i].first,
                     outputs[j].first,
-                    outputs[i].second.c_str());
+                    outputs[i].second->c_str());
         return false;
       }
   }
@@ -227,12 +236,7 @@ parseOptions(int argc, char** argv, Options& opt)
       !selseg_apps::optionsGivenOnce(
           argc, argv, [](const std::string& arg) { return optionKind(arg) == 1; }))
     return kUsageError;
-  for (const auto& [flag, name] : {std::make_pair("-o", &opt.labels),
-                                   std::make_pair("-mesh_ply", &opt.mesh_ply),
-                                   std::make_pair("-mesh_vtk", &opt.mesh_vtk),
-                                   std::make_pair("-leaves", &opt.leaves),
-                                   std::make_pair("-json", &opt.json),
-                                   std::make_pair("-roi_json", &opt.roi_json)})
+  for (const auto& [flag, name] : outputFiles(opt))
     if (!selseg_apps::parseFileName(argc, argv, flag, *name))
       return kUsageError;
   opt.ignore_viewpoint = find_switch(argc, argv, "-ignore_viewpoint");
@@ -440,13 +444,9 @@ segment(const Options& opt)
   std::string error;
   // The outputs are checked before the work that makes them (a folder, a missing
   // folder, a FIFO), as the viewer and the simulator check theirs.
-  for (const std::string* path : {&opt.labels,
-                                  &opt.mesh_ply,
-                                  &opt.mesh_vtk,
-                                  &opt.leaves,
-                                  &opt.json,
-                                  &opt.roi_json})
-    if (!path->empty() && !selseg_apps::outputWritable(*path, error)) {
+  for (const auto& output : outputFiles(opt))
+    if (!output.second->empty() &&
+        !selseg_apps::outputWritable(*output.second, error)) {
       print_error("%s\n", error.c_str());
       return kRuntimeError;
     }

@@ -501,7 +501,7 @@ plyHeaderUsable(const std::string& path,
   std::size_t vertex_properties = 0;
   // ASCII: one line per element item, the vertices after the items of the elements
   // declared before them.
-  bool ascii = false, vertex_has_list = false, vertex_seen = false;
+  bool ascii = false, vertex_has_list = false;
   unsigned long long lines_before_vertices = 0;
   while (std::getline(in, line)) {
     // PCL's PLY reader splits some lines at spaces and tabs only and asserts on what it
@@ -569,8 +569,7 @@ plyHeaderUsable(const std::string& path,
         vertices = count;
       in_element = true;
       in_vertex = name == "vertex";
-      vertex_seen |= in_vertex;
-      if (ok && !vertex_seen)
+      if (ok && vertices < 0) // an element before the vertices
         lines_before_vertices += static_cast<unsigned long long>(count);
     } else if (keyword == "property" && in_element) {
       std::string type, name;
@@ -636,24 +635,20 @@ extractXYZ(const std::string& path,
   bool any_double = false;
   for (int k = 0; k < 3; ++k)
     any_double |= fields[k]->datatype == pcl::PCLPointField::FLOAT64;
-  for (std::size_t i = 0; i < points; ++i)
-    for (int k = 0; k < 3; ++k)
-      cloud[i].data[k] = static_cast<float>(coordinate(i, k));
-  if (!any_double)
-    return true;
   // Coordinates far from the origin (georeferenced scans) lose their last digits in
-  // float: refuse when float's rounding there reaches a tenth of the points' spacing
-  // (the median distance between consecutive distinct points, which scans store in
-  // scan order), rather than segment a distorted scan. Near-duplicates that float
-  // merges at a small distance from the origin are no reason to refuse.
+  // float: with doubles, refuse when float's rounding there reaches a tenth of the
+  // points' spacing (the median distance between consecutive distinct points, which
+  // scans store in scan order), rather than segment a distorted scan. Near-duplicates
+  // that float merges at a small distance from the origin are no reason to refuse.
   double largest = 0.0;
   std::vector<double> steps;
   bool first = true;
   Eigen::Vector3d previous_point = Eigen::Vector3d::Zero();
   for (std::size_t i = 0; i < points; ++i) {
-    if (!cloud[i].getVector3fMap().allFinite())
-      continue;
     const Eigen::Vector3d p(coordinate(i, 0), coordinate(i, 1), coordinate(i, 2));
+    cloud[i].getVector3fMap() = p.cast<float>();
+    if (!any_double || !cloud[i].getVector3fMap().allFinite())
+      continue;
     largest = std::max(largest, p.cwiseAbs().maxCoeff());
     if (!first) {
       const double step = (p - previous_point).norm();

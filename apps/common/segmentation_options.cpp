@@ -88,6 +88,17 @@ parseChoice(
   return false;
 }
 
+/** Whether strtod() reads all of \a text, and not nothing, as \a value (errno set
+ * as strtod() leaves it: ERANGE beyond a double's range or towards 0). */
+bool
+wholeNumber(const char* text, double& value)
+{
+  char* end = nullptr;
+  errno = 0;
+  value = std::strtod(text, &end);
+  return end != text && *end == '\0';
+}
+
 } // namespace
 
 std::string
@@ -138,10 +149,8 @@ readOptionNumber(const char* flag,
     print_error("Option %s needs a value (see -h).\n", flag);
     return false;
   }
-  char* end = nullptr;
-  errno = 0;
-  const double v = std::strtod(text, &end);
-  if (end == text || *end != '\0' || std::isnan(v)) {
+  double v = 0.0;
+  if (!wholeNumber(text, v) || std::isnan(v)) {
     print_error("Option %s needs a number, not '%s' (see -h).\n", flag, text);
     return false;
   }
@@ -178,11 +187,9 @@ parseNumberList(
   for (std::size_t begin = 0; numbers && begin <= text.size();) {
     const std::size_t end = std::min(text.find(',', begin), text.size());
     const std::string item = text.substr(begin, end - begin);
-    char* stop = nullptr;
-    errno = 0;
-    const double value = std::strtod(item.c_str(), &stop);
-    numbers = !item.empty() && stop == item.c_str() + item.size() &&
-              std::isfinite(value); // a denormal is a number
+    double value = 0.0;
+    // A denormal is a number.
+    numbers = wholeNumber(item.c_str(), value) && std::isfinite(value);
     read.push_back(value);
     begin = end + 1;
   }
