@@ -160,6 +160,23 @@ protected:
            " -leaves " + shellQuoted(o / "leaves.pcd") + " -json " +
            shellQuoted(o / "summary.json");
   }
+  /** The tool's labels file for \a input run with \a options, written to
+   * out/labels.pcd, read into \a labeled and removed; false, with a failure recorded,
+   * when the run or the read fails. */
+  bool labeledBy(const fs::path& input,
+                 const std::string& options,
+                 pcl::PointCloud<pcl::PointXYZL>& labeled)
+  {
+    const fs::path labels = dir / "out" / "labels.pcd";
+    const Outcome o =
+        run(shellQuoted(input) + " " + options + " -o " + shellQuoted(labels));
+    EXPECT_EQ(o.code, 0) << input << ": " << o.messages;
+    const bool read =
+        o.code == 0 && pcl::io::loadPCDFile(labels.string(), labeled) == 0;
+    EXPECT_TRUE(read) << labels;
+    fs::remove(labels);
+    return read;
+  }
   /** The tool must fail on \a input with exit code 1, say \a why, write nothing. */
   void expectRejected(const fs::path& input, const std::string& why)
   {
@@ -267,18 +284,13 @@ TEST_F(ToolFailure, FieldTypesAreCheckedOrConverted)
   for (const auto& p : cloud)
     doubles << p.x << " " << p.y << " " << p.z << "\n";
   writeFile(in / "doubles.pcd", doubles.str());
-  const fs::path labels = dir / "out" / "labels.pcd";
-  const Outcome o = run(shellQuoted(in / "doubles.pcd") + " -ignore_viewpoint -o " +
-                        shellQuoted(labels));
-  ASSERT_EQ(o.code, 0) << o.messages;
   pcl::PointCloud<pcl::PointXYZL> labeled;
-  ASSERT_EQ(pcl::io::loadPCDFile(labels.string(), labeled), 0);
+  ASSERT_TRUE(labeledBy(in / "doubles.pcd", "-ignore_viewpoint", labeled));
   ASSERT_EQ(labeled.size(), cloud.size());
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     ASSERT_EQ(labeled[i].getVector3fMap(), cloud[i].getVector3fMap()) << i;
     ASSERT_EQ(labeled[i].label, 1u) << i;
   }
-  fs::remove(labels);
 
   std::ostringstream bytes;
   bytes << pcdHeader("x y z", "1 1 1", "U U U", "1 1 1", cloud.size(), "ascii");
@@ -489,12 +501,8 @@ TEST_F(ToolFailure, PlyLayoutMustMatchTheVertices)
   holed.at(5, 5).x = std::numeric_limits<float>::quiet_NaN();
   pcl::PLYWriter().write((in / "holed.ply").string(), holed, true, false);
   ASSERT_NE(readFile(in / "holed.ply").find("obj_info num_rows 30"), std::string::npos);
-  const fs::path labels = dir / "out" / "labels.pcd";
-  const Outcome o = run(shellQuoted(in / "holed.ply") + " -ignore_viewpoint -o " +
-                        shellQuoted(labels));
-  ASSERT_EQ(o.code, 0) << o.messages;
   pcl::PointCloud<pcl::PointXYZL> out;
-  ASSERT_EQ(pcl::io::loadPCDFile(labels.string(), out), 0);
+  ASSERT_TRUE(labeledBy(in / "holed.ply", "-ignore_viewpoint", out));
   EXPECT_EQ(out.size(), holed.size() - 1);
   EXPECT_EQ(out.height, 1u);
 }
@@ -523,16 +531,11 @@ TEST_F(ToolFailure, PlyColoursInAnotherOrderAreRefused)
     return f.str();
   };
   writeFile(in / "rgba.ply", ply({"red", "green", "blue", "alpha"}));
-  const fs::path labels = dir / "out" / "labels.pcd";
-  const Outcome ok = run(shellQuoted(in / "rgba.ply") + " -ignore_viewpoint -o " +
-                         shellQuoted(labels));
-  EXPECT_EQ(ok.code, 0) << ok.messages;
   pcl::PointCloud<pcl::PointXYZL> out;
-  ASSERT_EQ(pcl::io::loadPCDFile(labels.string(), out), 0);
+  ASSERT_TRUE(labeledBy(in / "rgba.ply", "-ignore_viewpoint", out));
   ASSERT_EQ(out.size(), cloud.size());
   for (std::size_t i = 0; i < cloud.size(); ++i)
     ASSERT_EQ(out[i].getVector3fMap(), cloud[i].getVector3fMap()) << i;
-  fs::remove(labels);
   const std::vector<std::vector<std::string>> refused = {
       {"blue", "green", "red"},
       {"blue"},
@@ -597,12 +600,8 @@ TEST_F(ToolFailure, UnitScaleScalesTheViewpoint)
     p.getVector3fMap() *= 100.0f; // cm, the wall at 100 cm
   cloud.sensor_origin_ = Eigen::Vector4f(0.0f, 0.0f, 50.0f, 0.0f);
   pcl::io::savePCDFileBinary((in / "cm.pcd").string(), cloud);
-  const fs::path labels = dir / "out" / "labels.pcd";
-  const Outcome o =
-      run(shellQuoted(in / "cm.pcd") + " -unit_scale 0.01 -o " + shellQuoted(labels));
-  ASSERT_EQ(o.code, 0) << o.messages;
   pcl::PointCloud<pcl::PointXYZL> out;
-  ASSERT_EQ(pcl::io::loadPCDFile(labels.string(), out), 0);
+  ASSERT_TRUE(labeledBy(in / "cm.pcd", "-unit_scale 0.01", out));
   EXPECT_NEAR(out.sensor_origin_.z(), 0.5f, 1e-6f);
   EXPECT_NEAR(out[0].z, 1.0f, 1e-6f);
   EXPECT_GT(out[0].label, 0u);
