@@ -355,8 +355,15 @@ evaluate(const std::string& path, std::string& table)
   }
   const std::string scene = path.substr(path.find_last_of('/') + 1);
   for (const auto& method : methods()) {
-    if (method.organized_only && !cloud->isOrganized())
+    if (method.organized_only && !cloud->isOrganized()) {
+      print_warn("%s is left out for '%s': it needs an organized cloud (height > 1), "
+                 "and this one is %u x %u.\n",
+                 method.name.c_str(),
+                 path.c_str(),
+                 cloud->width,
+                 cloud->height);
       continue;
+    }
     const Run run = method.run(cloud);
     const std::string line = row(scene, method.name, *cloud, truth, run);
     std::fputs(line.c_str(), stdout);
@@ -442,7 +449,9 @@ run(int argc, char** argv)
                "  CLOUD.pcd  x y z label (ground truth; 0 = invalid), seen from the "
                "file's VIEWPOINT\n"
                "  -o FILE    also write the markdown table to FILE (only when every "
-               "cloud was read)\n",
+               "cloud was read)\n"
+               "Methods: this project's, RegionGrowing, Supervoxel+LCCP, and on "
+               "organized clouds\n(height > 1) OrganizedMultiPlane.\n",
                argv[0]);
     return argc < 2 ? kUsageError : 0;
   }

@@ -95,7 +95,8 @@ struct Options {
   double unit_scale = 1.0;
   bool ignore_viewpoint = false;
   SelectiveSegmentationParameters params;
-  std::array<bool, kNumLayers> view = {true, false, false, false, true}; ///< at start
+  /// Layers shown at start: -view's, else the mesh, and the regions when given.
+  std::array<bool, kNumLayers> view = {true, false, false, false, false};
   bool roi = false;     ///< compute regions of interest from the segmentation
   std::string roi_json; ///< or read them from this file
   pcl::selective_seg::RegionOfInterestParameters roi_params;
@@ -316,6 +317,8 @@ parseOptions(int argc, char** argv, Options& opt)
     print_error("Give -roi or -roi_json, not both.\n");
     return kUsageError;
   }
+  if (find_argument(argc, argv, "-view") < 0)
+    opt.view[kRegions] = opt.roi || !opt.roi_json.empty();
   // The -roi_* settings choose the windows -roi computes; a -roi_json file's windows
   // are drawn as they are.
   if (!opt.roi)

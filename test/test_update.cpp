@@ -443,6 +443,27 @@ TEST(SelectiveSegmentationUpdate, ChangedSplitThresholdKeepsNoLeaf)
   expectSameResult(seg, ref);
 }
 
+// A positive finest voxel set before update() replaces the kept one: the result is
+// extract()'s on the union with that voxel (in place, no leaf kept: the voxels
+// changed).
+TEST(SelectiveSegmentationUpdate, VoxelSetBeforeTheUpdateIsUsed)
+{
+  const auto scan = toXYZ(*selseg_test::cubeScan(5000, 15));
+  const std::size_t n = scan->size();
+  Seg seg;
+  const double voxel = extractFirst(seg, slice(*scan, 0, n * 3 / 4));
+  const double larger = 3.0 * voxel;
+  seg.setMinVoxelSize(larger);
+  std::vector<pcl::PointIndices> clusters;
+  ASSERT_TRUE(seg.update(*slice(*scan, n * 3 / 4, n), clusters));
+  EXPECT_TRUE(seg.getUpdateStatistics().incremental);
+  EXPECT_EQ(seg.getUpdateStatistics().kept_leaves, 0u);
+  EXPECT_EQ(seg.getResult().min_voxel_size, larger);
+  Seg ref;
+  reference(scan, larger, ref);
+  expectSameResult(seg, ref);
+}
+
 // The result belongs to the input and indices it was made from: set again since,
 // update() segments the union of the current input and the new points from scratch
 // (it must not fold the new points into a mesh of other points).
@@ -510,6 +531,13 @@ TEST(SelectiveSegmentationUpdate, FailedUpdateLeavesTheInputAsItWas)
   seg.setMaxMergeAngle(25.0 * M_PI / 180.0);
   ASSERT_TRUE(seg.update(*slice(*scan, n / 2, n), clusters));
   EXPECT_TRUE(seg.getUpdateStatistics().incremental);
+  EXPECT_EQ(seg.getUpdateStatistics().new_points, n - n / 2);
+  // Refused for its parameters: the statistics are not the call's before it.
+  seg.setMaxMergeAngle(-1.0);
+  EXPECT_FALSE(seg.update(*slice(*scan, 0, 10), clusters));
+  EXPECT_EQ(seg.getUpdateStatistics().new_points, 0u);
+  EXPECT_FALSE(seg.getUpdateStatistics().incremental);
+  seg.setMaxMergeAngle(25.0 * M_PI / 180.0);
   Seg ref;
   reference(scan, voxel, ref);
   expectSameResult(seg, ref);
@@ -522,6 +550,10 @@ TEST(SelectiveSegmentationUpdate, FailedUpdateLeavesTheInputAsItWas)
   EXPECT_FALSE(seg.update(*slice(*scan, 0, 10), clusters));
   EXPECT_EQ(seg.getInputCloud(), input);
   EXPECT_EQ(seg.getIndices(), bad);
+  // A refused call leaves no statistics of the update before it.
+  EXPECT_FALSE(seg.getUpdateStatistics().incremental);
+  EXPECT_EQ(seg.getUpdateStatistics().new_points, 0u);
+  EXPECT_EQ(seg.getUpdateStatistics().kept_leaves, 0u);
 }
 
 TEST(SelectiveSegmentationUpdate, NeedsAResultToUpdate)

@@ -191,7 +191,8 @@ struct PCL_EXPORTS SelectiveSegmentationParameters {
 
   /** \brief Smallest octree voxel edge [m]; voxels of this size are never split.
    * 0 = automatic: min_voxel_size_factor times the median 3-D edge length of the
-   * Delaunay mesh (the median point spacing). Valid: 0 or a positive finite value. */
+   * Delaunay mesh (the median point spacing; SegmentationResult::median_spacing says
+   * how it is sampled on large meshes). Valid: 0 or a positive finite value. */
   double min_voxel_size = 0.0;
 
   /** \brief Automatic minimum voxel size in units of the median point spacing

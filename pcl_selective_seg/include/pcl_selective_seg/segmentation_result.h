@@ -57,8 +57,10 @@ struct PointCounts {
    * (delaunay2dPeriodic()). */
   std::size_t without_normal = 0;
   std::size_t labeled = 0;         ///< given a segment label > 0
-  std::size_t shared_vertex = 0;   ///< of the labeled: same quantized angles as another
-                                   ///< point, so they share that mesh vertex and label
+  /// Of the labeled: points on the same quantized angles as a nearer point, which
+  /// represents their shared mesh vertex (the representative itself is not counted:
+  /// two points on one vertex count 1); they take that vertex's label.
+  std::size_t shared_vertex = 0;
 };
 
 /** \brief A leaf of the multi-resolution octree: a seed segment. */
@@ -114,7 +116,9 @@ struct SegmentationResult {
   StageTimings timings;
   std::size_t num_vertices = 0; ///< mesh vertices (distinct quantized angles)
   double min_voxel_size = 0.0;  ///< the octree's finest voxel edge actually used [m]
-  double median_spacing = 0.0;  ///< median 3-D edge length of the mesh [m]
+  /// Median 3-D edge length of the mesh [m]; over 100,000 triangles, the median over
+  /// every k-th triangle's edges, k = triangles / 100,000 (a fixed sample).
+  double median_spacing = 0.0;
 
   void clear() { *this = SegmentationResult(); }
 };

@@ -74,14 +74,24 @@ struct MergeReplay; // region_merging.h
 /** \brief What the last SelectiveSegmentation::update() changed. */
 struct UpdateStatistics {
   /** The mesh and normals were updated in place; false: the pipeline ran from scratch
-   * on the union (no mesh to update, or parameters or sensor pose changed since). */
+   * on the union, because the input cloud or the indices were set again since the run
+   * being updated, the sensor pose or a parameter of stages 1-3 changed
+   * (angle_quantization, max_view_incidence_angle, normal_rings,
+   * point_normal_triangles), the projection is panoramic, VTK's backend made or
+   * would make the mesh, or the local insertion failed its own checks
+   * (docs/incremental_update.md, "When it runs from scratch"). Other parameters
+   * (merge and split angles, weights, ...) may change between the calls: the update
+   * stays in place and applies them. */
   bool incremental = false;
   std::size_t new_points = 0;     ///< points given to update()
   std::size_t new_vertices = 0;   ///< mesh vertices they added
   std::size_t moved_vertices = 0; ///< vertices now represented by a nearer new point
   std::size_t replaced_triangles = 0; ///< old triangles the insertion replaced
   std::size_t new_triangles = 0;      ///< triangles not in the old mesh
-  std::size_t changed_vertices = 0;   ///< vertices whose normal was recomputed
+  /// Corners of the new triangles and of the old ones at a moved vertex: the vertices
+  /// whose one-ring changed (with normal_rings > 1 the normals of the vertices up to
+  /// normal_rings - 1 rings around them are recomputed too, and not counted here).
+  std::size_t changed_vertices = 0;
   /** Octree leaves kept from the previous result: those under nodes whose finest
    * voxels hold no new, moved or changed vertex (the rest are computed again). */
   std::size_t kept_leaves = 0;
@@ -256,7 +266,8 @@ public:
    * The input becomes a new cloud: the previous input followed by \a new_points
    * (given in the same frame as the input; unorganized, height 1). With indices set,
    * the new points' indices are appended to them. The finest voxel size of the run
-   * being updated is kept, so the result is that of extract() on the union with
+   * being updated is kept (unless setMinVoxelSize() set a positive size, which is
+   * then used), so the result is that of extract() on the union with
    * setMinVoxelSize(getResult().min_voxel_size), bit for bit
    * (docs/incremental_update.md: what is recomputed, and when it runs from scratch).
    * If the input cloud or the indices were set again since that run, the union of the
@@ -270,7 +281,8 @@ public:
    *         cleared when a stage failed or memory ran out. */
   bool update(const PointCloud& new_points, std::vector<pcl::PointIndices>& clusters);
 
-  /** \brief What the last update() changed. */
+  /** \brief What the last update() changed: all zero (and not incremental) when that
+   * call failed or was refused. */
   const UpdateStatistics& getUpdateStatistics() const { return update_stats_; }
 
   /** \brief Labels, segments, leaves, mesh, counts and timings of the last extract()

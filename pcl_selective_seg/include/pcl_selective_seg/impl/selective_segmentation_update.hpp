@@ -20,6 +20,7 @@ SelectiveSegmentation<PointT>::update(const PointCloud& new_points,
                                       std::vector<pcl::PointIndices>& clusters)
 {
   clusters.clear();
+  update_stats_ = UpdateStatistics();
   if (!input_ || !mesh_input_ || result_.segments.empty()) {
     PCL_ERROR("[pcl::selective_seg::%s::update] no result to update: call extract() "
               "first\n",
@@ -47,7 +48,8 @@ SelectiveSegmentation<PointT>::update(const PointCloud& new_points,
     ok = failOutOfMemory("update");
   }
   params_ = saved;
-  if (!ok) { // the input and indices before the call
+  if (!ok) { // the input and indices before the call; no statistics
+    update_stats_ = UpdateStatistics();
     this->setInputCloud(previous_input);
     if (previous_indices)
       this->setIndices(previous_indices);
@@ -62,7 +64,6 @@ SelectiveSegmentation<PointT>::updateUnion(const PointCloud& new_points,
                                            std::vector<pcl::PointIndices>& clusters)
 {
   pcl::StopWatch total;
-  update_stats_ = UpdateStatistics();
   update_stats_.new_points = new_points.size();
   const std::size_t first_new = input_->size();
   auto merged = pcl::make_shared<PointCloud>();
