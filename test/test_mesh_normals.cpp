@@ -372,6 +372,46 @@ TEST(MeshNormals, EdgeOnHeadOnAndGrazing)
   EXPECT_EQ(edge_on[0], 1);
 }
 
+// Ring counts below 1 and incidence angles that are NaN or negative are refused with
+// a message: empty outputs, in-place arrays as they were (rings 0 gave NaN normals,
+// a NaN angle flagged nothing, a negative one acted as its absolute value).
+TEST(MeshNormals, UnusableRingsOrIncidenceAreRefused)
+{
+  using namespace pcl::selective_seg;
+  const std::vector<Triangle> tris{{0, 1, 2}, {1, 3, 2}};
+  const Vector3fVector n{Eigen::Vector3f(0, 0, -1), Eigen::Vector3f(0, 0, -1)};
+  const std::vector<double> areas{1.0, 1.0};
+  Vector3fVector ring_normals(3);
+  computeVertexNormalsOverRings(4, tris, n, areas, 0, ring_normals);
+  EXPECT_TRUE(ring_normals.empty());
+  computeVertexNormalsOverRings(4, tris, n, areas, 1, ring_normals);
+  ASSERT_EQ(ring_normals.size(), 4u);
+  Vector3fVector missing(4, Eigen::Vector3f::Constant(NAN));
+  EXPECT_EQ(fillMissingVertexNormals(tris, n, areas, 0, missing), 0u);
+  EXPECT_FALSE(missing[0].allFinite());
+  EXPECT_EQ(fillMissingVertexNormals(tris, n, areas, 1, missing), 4u);
+
+  const Vector3fVector positions{Eigen::Vector3f(0, 0, 5),
+                                 Eigen::Vector3f(1, 0, 5),
+                                 Eigen::Vector3f(0, 1, 5),
+                                 Eigen::Vector3f(1, 1, 5)};
+  for (const double bad : {std::numeric_limits<double>::quiet_NaN(), -0.5}) {
+    SCOPED_TRACE(bad);
+    std::vector<std::uint8_t> edge_on{1, 1, 1};
+    markEdgeOnTriangles(positions, tris, n, Eigen::Vector3f::Zero(), bad, edge_on);
+    EXPECT_TRUE(edge_on.empty());
+    Vector3fVector normals(5);
+    std::vector<double> tri_areas(5);
+    std::vector<std::uint8_t> flags(5);
+    computeTriangleNormalsAndEdgeOn(
+        positions, tris, Eigen::Vector3f::Zero(), bad, normals, tri_areas, flags);
+    EXPECT_TRUE(normals.empty() && tri_areas.empty() && flags.empty());
+  }
+  std::vector<std::uint8_t> edge_on;
+  markEdgeOnTriangles(positions, tris, n, Eigen::Vector3f::Zero(), 0.5, edge_on);
+  EXPECT_EQ(edge_on.size(), 2u);
+}
+
 TEST(MeshNormals, EdgeOnThreshold)
 {
   // A triangle centred on the optical axis at z = 5 whose normal makes 60 degrees with

@@ -1277,6 +1277,99 @@ TEST(OctreePointCloudNormalVariance, SecondInsertionKeepsTheBox)
   EXPECT_EQ(pointsOutsideTheirVoxel(octree), 0u);
 }
 
+// A second insertion whose points lie so far away that the grown box would need more
+// than kMaxDepth levels is refused before PCL starts growing it (it grew a level at a
+// time until memory ran out), and the tree is left as it was.
+TEST(OctreePointCloudNormalVariance, GrowthBeyondTheDepthLimitIsRefusedUpFront)
+{
+  auto cloud = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  auto normals = std::make_shared<std::vector<Eigen::Vector3f>>();
+  auto areas = std::make_shared<std::vector<double>>();
+  for (int i = 0; i < 100; ++i) {
+    cloud->push_back(pcl::PointXYZ(0.01f * static_cast<float>(i), 0.0f, 1.0f));
+    normals->push_back(Eigen::Vector3f(0.0f, 0.0f, -1.0f));
+    areas->push_back(1e-4);
+  }
+  cloud->push_back(pcl::PointXYZ(1e8f, 0.0f, 1.0f)); // 2^33 voxels away
+  normals->push_back(Eigen::Vector3f(0.0f, 0.0f, -1.0f));
+  areas->push_back(1e-4);
+  Octree octree(0.01);
+  octree.setInputNormals(normals, areas);
+  pcl::Indices first(100);
+  std::iota(first.begin(), first.end(), 0);
+  octree.setInputCloud(cloud, pcl::make_shared<const pcl::Indices>(first));
+  ASSERT_TRUE(octree.addPointsFromInputCloud());
+  const unsigned depth = octree.getTreeDepth();
+  const std::size_t leaves = octree.getLeafCount();
+  octree.setInputCloud(cloud, pcl::make_shared<const pcl::Indices>(pcl::Indices{100}));
+  EXPECT_FALSE(octree.addPointsFromInputCloud());
+  EXPECT_EQ(octree.getTreeDepth(), depth);
+  EXPECT_EQ(octree.getLeafCount(), leaves);
+  // Within reach, the same insertion grows the box (PCL's behaviour).
+  (*cloud)[100].x = 100.0f;
+  EXPECT_TRUE(octree.addPointsFromInputCloud());
+  EXPECT_GT(octree.getTreeDepth(), depth);
+  EXPECT_EQ(octree.getLeafCount(), leaves + 1);
+}
+
+// Inputs that disagree are refused with a message, not read as "invalid points":
+// normals or areas fewer than the points, and indices beyond the cloud.
+TEST(OctreePointCloudNormalVariance, InputsThatDisagreeAreRefused)
+{
+  const Scene scene = randomCube(200, 1.0);
+  {
+    auto fewer = pcl::make_shared<pcl::PointCloud<pcl::Normal>>(*scene.normals);
+    fewer->resize(100);
+    Octree octree(0.1);
+    octree.setInputCloud(scene.cloud);
+    octree.setInputNormals(fewer, scene.areas);
+    EXPECT_FALSE(octree.addPointsFromInputCloud());
+    EXPECT_EQ(octree.getLeafCount(), 0u);
+  }
+  {
+    auto fewer = std::make_shared<std::vector<double>>(*scene.areas);
+    fewer->pop_back();
+    Octree octree(0.1);
+    octree.setInputCloud(scene.cloud);
+    octree.setInputNormals(scene.normals, fewer);
+    EXPECT_FALSE(octree.addPointsAndComputeAdaptiveLeaves(kPaperThreshold, kMinPoints));
+    EXPECT_TRUE(octree.getAdaptiveLeaves().empty());
+  }
+  for (const pcl::index_t bad : {pcl::index_t{-5}, pcl::index_t{200}}) {
+    Octree octree(0.1);
+    octree.setInputCloud(
+        scene.cloud, pcl::make_shared<const pcl::Indices>(pcl::Indices{0, 1, 2, bad}));
+    octree.setInputNormals(scene.normals, scene.areas);
+    EXPECT_FALSE(octree.addPointsFromInputCloud()) << bad;
+    EXPECT_EQ(octree.getLeafCount(), 0u) << bad;
+  }
+  Octree none(0.1); // no normals at all
+  none.setInputCloud(scene.cloud);
+  EXPECT_FALSE(none.addPointsFromInputCloud());
+}
+
+// A split threshold outside (0, pi] (NaN included) or a sensor orientation that is no
+// rotation gives no leaves, with a message, instead of one leaf or every finest voxel.
+TEST(OctreePointCloudNormalVariance, InvalidThresholdOrOrientationGivesNoLeaves)
+{
+  const Scene scene = randomCube(300, 1.0);
+  for (const double threshold :
+       {std::numeric_limits<double>::quiet_NaN(), -1.0, 0.0, 4.0, HUGE_VAL}) {
+    const auto octree = buildOctree(scene, 0.1, threshold);
+    EXPECT_TRUE(octree->getAdaptiveLeaves().empty()) << threshold;
+  }
+  Octree octree(0.1);
+  octree.setInputCloud(scene.cloud);
+  octree.setInputNormals(scene.normals, scene.areas);
+  octree.setSensorOrientation(Eigen::Quaternionf(NAN, 0.0f, 0.0f, 0.0f));
+  ASSERT_TRUE(octree.addPointsFromInputCloud());
+  octree.computeAdaptiveLeaves(kPaperThreshold, kMinPoints);
+  EXPECT_TRUE(octree.getAdaptiveLeaves().empty());
+  octree.setSensorOrientation(Eigen::Quaternionf::Identity());
+  octree.computeAdaptiveLeaves(kPaperThreshold, kMinPoints);
+  EXPECT_FALSE(octree.getAdaptiveLeaves().empty());
+}
+
 TEST(OctreePointCloudNormalVariance, DeleteTreeDeletesTheLeaves)
 {
   const Scene scene = ridge();

@@ -203,12 +203,17 @@ TEST(MergeSeedSegments, MissingOrMismatchedArraysGiveEmptyOutputs)
   const MergeInput good = strip.input();
   Vector3fVector one_normal(1, Eigen::Vector3f(0.f, 0.f, -1.f));
   std::vector<std::uint8_t> short_flags(1, 0);
-  std::vector<MergeInput> bad(5, good);
+  std::vector<MergeInput> bad(9, good);
   bad[0].vertex_leaf = nullptr;
   bad[1].triangles = nullptr;
   bad[2].leaf_areas = nullptr;
   bad[3].triangle_normals = &one_normal;
   bad[4].triangle_edge_on = &short_flags;
+  // Angles outside [0, pi]: NaN compared false and merged every reachable seed.
+  bad[5].max_merge_angle = std::numeric_limits<double>::quiet_NaN();
+  bad[6].max_merge_angle = -0.1;
+  bad[7].max_edge_triangle_angle = std::numeric_limits<double>::quiet_NaN();
+  bad[8].max_edge_triangle_angle = 4.0;
   for (std::size_t k = 0; k < bad.size(); ++k) {
     SCOPED_TRACE(k);
     std::vector<pcl::index_t> leaf_segment{7};
@@ -732,6 +737,31 @@ TEST(ClassifyTriangles, Classes)
                     classes);
   EXPECT_EQ(labels[4], 2u);
   EXPECT_EQ(classes[4], TriangleClass::ValidEdge);
+}
+
+TEST(ClassifyTriangles, MismatchedArraysOrAnglesGiveEmptyOutputs)
+{
+  const Vector3fVector label_normals{tilted(0.0), tilted(40.0)};
+  const std::vector<std::uint32_t> vertex_labels{1, 1, 1, 2};
+  const std::vector<Triangle> triangles{{0, 1, 2}, {0, 1, 3}};
+  const Vector3fVector normals{tilted(0.0), tilted(30.0)};
+  const Vector3fVector one_normal{tilted(0.0)};
+  const std::vector<std::uint8_t> one_flag{0};
+  const auto classify = [&](const Vector3fVector& n,
+                            const std::vector<std::uint8_t>* flags,
+                            double angle) {
+    std::vector<std::uint32_t> labels{9};
+    std::vector<TriangleClass> classes{TriangleClass::Interior};
+    classifyTriangles(
+        triangles, n, flags, vertex_labels, label_normals, angle, labels, classes);
+    EXPECT_EQ(labels.size(), classes.size());
+    return labels.size();
+  };
+  EXPECT_EQ(classify(normals, nullptr, 25.0 * kDeg), 2u);
+  EXPECT_EQ(classify(one_normal, nullptr, 25.0 * kDeg), 0u);
+  EXPECT_EQ(classify(normals, &one_flag, 25.0 * kDeg), 0u);
+  EXPECT_EQ(classify(normals, nullptr, std::numeric_limits<double>::quiet_NaN()), 0u);
+  EXPECT_EQ(classify(normals, nullptr, -1.0), 0u);
 }
 
 TEST(ClassifyTriangles, InteriorIgnoresNormal)

@@ -181,9 +181,11 @@ TEST(SelectiveLoop, WindowsStayInTheViewAndTheBudgetIsUsed)
   std::vector<sim::ScanScore> rounds;
   pcl::PointCloud<pcl::PointXYZL> last; // a copy: the loop's clouds end with it
   std::size_t windows = 0;
+  std::vector<std::size_t> scanned; // windows scanned in each round
   ASSERT_TRUE(sim::runSelectiveLoop(
       setup, params, reference, rounds, [&](const sim::LoopRound& r) {
         last = *r.cloud;
+        scanned.push_back(r.regions->size());
         for (const auto& w : *r.regions) {
           ++windows;
           EXPECT_GE(w.theta_min, setup.sensor.theta_min);
@@ -194,6 +196,12 @@ TEST(SelectiveLoop, WindowsStayInTheViewAndTheBudgetIsUsed)
       }));
   ASSERT_EQ(last.size(), rounds.back().points);
   EXPECT_GT(windows, 0u);
+  // Each score counts the windows of the step that led to it: the coarse scan is one
+  // window (the whole view), then the windows the round before scanned.
+  ASSERT_EQ(scanned.size(), rounds.size());
+  EXPECT_EQ(rounds.front().windows, 1u);
+  for (std::size_t k = 1; k < rounds.size(); ++k)
+    EXPECT_EQ(rounds[k].windows, scanned[k - 1]) << "round " << k;
   // Every point acquired lies in the view (up to the float rounding of its angles).
   std::size_t outside = 0;
   for (const auto& p : last) {

@@ -194,6 +194,30 @@ minIncidenceCos(double max_incidence)
   return max_incidence >= M_PI / 2.0 ? 0.0 : std::cos(max_incidence);
 }
 
+/** Whether an incidence angle is usable (>= 0; NaN is not); a PCL_ERROR otherwise. */
+bool
+incidenceUsable(double max_incidence, const char* where)
+{
+  if (max_incidence >= 0.0)
+    return true;
+  PCL_ERROR("[pcl::selective_seg::%s] max_incidence is %g rad: give an angle >= 0 "
+            "(pi/2 or more flags only degenerate triangles)\n",
+            where,
+            max_incidence);
+  return false;
+}
+
+/** Whether a ring count is usable (>= 1); a PCL_ERROR otherwise. */
+bool
+ringsUsable(int rings, const char* where)
+{
+  if (rings >= 1)
+    return true;
+  PCL_ERROR(
+      "[pcl::selective_seg::%s] rings is %d: give 1 (eq. 2) or more\n", where, rings);
+  return false;
+}
+
 } // namespace
 
 void
@@ -224,6 +248,12 @@ computeTriangleNormalsAndEdgeOn(const Vector3fVector& positions,
                                 std::vector<std::uint8_t>& edge_on,
                                 int num_threads)
 {
+  if (!incidenceUsable(max_incidence, "computeTriangleNormalsAndEdgeOn")) {
+    normals.clear();
+    areas.clear();
+    edge_on.clear();
+    return;
+  }
   // Every entry is written below.
   detail::resizeLarge(normals, triangles.size());
   detail::resizeLarge(areas, triangles.size());
@@ -249,6 +279,19 @@ updateTriangleNormalsAndEdgeOn(const Vector3fVector& positions,
                                std::vector<std::uint8_t>& edge_on,
                                int num_threads)
 {
+  if (!incidenceUsable(max_incidence, "updateTriangleNormalsAndEdgeOn") ||
+      normals.size() != old_to_new.size() || areas.size() != old_to_new.size() ||
+      edge_on.size() != old_to_new.size()) {
+    if (max_incidence >= 0.0)
+      PCL_ERROR("[pcl::selective_seg::updateTriangleNormalsAndEdgeOn] the old arrays "
+                "(%zu normals, %zu areas, %zu flags) need one entry per old triangle "
+                "(%zu)\n",
+                normals.size(),
+                areas.size(),
+                edge_on.size(),
+                old_to_new.size());
+    return; // the arrays as they were
+  }
   const std::size_t n_new = triangles.size();
   Vector3fVector new_normals(n_new);
   std::vector<double> new_areas(n_new);
@@ -642,6 +685,10 @@ computeVertexNormalsOverRings(std::size_t num_vertices,
                               int rings,
                               Vector3fVector& vertex_normals)
 {
+  if (!ringsUsable(rings, "computeVertexNormalsOverRings")) {
+    vertex_normals.clear();
+    return;
+  }
   const Incidence incident = vertexTriangles(triangles, num_vertices);
   const auto list = [&](pcl::index_t v, std::vector<pcl::index_t>& out) {
     out.assign(incident.items.begin() + incident.offsets[v],
@@ -662,6 +709,8 @@ updateVertexNormalsOverRings(const std::vector<Triangle>& triangles,
                              const std::vector<pcl::index_t>& changed_triangles,
                              Vector3fVector& vertex_normals)
 {
+  if (!ringsUsable(rings, "updateVertexNormalsOverRings"))
+    return; // the normals as they were
   // One triangle at each vertex met, for the walks around it.
   const std::size_t num_vertices = vertex_normals.size();
   std::vector<pcl::index_t> some_triangle(num_vertices, -1);
@@ -727,6 +776,8 @@ fillMissingVertexNormals(const std::vector<Triangle>& triangles,
                          Vector3fVector& vertex_normals,
                          int num_threads)
 {
+  if (!ringsUsable(rings, "fillMissingVertexNormals"))
+    return 0; // the normals as they were
   const std::size_t num_vertices = vertex_normals.size();
   std::vector<pcl::index_t> missing;
   for (std::size_t v = 0; v < num_vertices; ++v)
@@ -790,6 +841,10 @@ markEdgeOnTriangles(const Vector3fVector& positions,
                     std::vector<std::uint8_t>& edge_on,
                     int num_threads)
 {
+  if (!incidenceUsable(max_incidence, "markEdgeOnTriangles")) {
+    edge_on.clear();
+    return;
+  }
   detail::assignLarge(edge_on, triangles.size(), 0);
   const double min_cos = minIncidenceCos(max_incidence);
   const Eigen::Vector3d eye = viewpoint.cast<double>();

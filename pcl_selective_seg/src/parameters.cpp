@@ -75,7 +75,7 @@ SelectiveSegmentationParameters::validate(std::string* why) const
   if (!inRange(angle_quantization, 2.5e-8, 1e-2))
     return reject(
         why, "angle_quantization [rad]", angle_quantization, "[2.5e-8, 1e-2]");
-  if (num_threads < 0 || num_threads > 1024)
+  if (num_threads < 0 || num_threads > detail::kMaxThreads)
     return reject(why, "num_threads", num_threads, "[0, 1024], 0 = automatic");
   if (edge_triangle_normal != EdgeTriangleNormal::Facet &&
       edge_triangle_normal != EdgeTriangleNormal::VertexMean)

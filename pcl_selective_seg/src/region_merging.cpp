@@ -763,6 +763,10 @@ mergeSeedSegments(const MergeInput& input,
            (input.triangle_edge_on &&
             input.triangle_edge_on->size() != input.triangles->size()))
     missing = "triangle_normals (and triangle_edge_on) need one entry per triangle";
+  else if (!(input.max_merge_angle >= 0.0 && input.max_merge_angle <= M_PI) ||
+           !(input.max_edge_triangle_angle >= 0.0 &&
+             input.max_edge_triangle_angle <= M_PI))
+    missing = "max_merge_angle and max_edge_triangle_angle must lie in [0, pi] rad";
   if (missing) {
     PCL_ERROR("[pcl::selective_seg::mergeSeedSegments] %s\n", missing);
     leaf_segment.clear();
@@ -786,6 +790,18 @@ classifyTriangles(const std::vector<Triangle>& triangles,
                   std::vector<TriangleClass>& classes,
                   int num_threads)
 {
+  const char* broken = nullptr;
+  if (triangle_normals.size() != triangles.size() ||
+      (triangle_edge_on && triangle_edge_on->size() != triangles.size()))
+    broken = "triangle_normals (and triangle_edge_on) need one entry per triangle";
+  else if (!(max_edge_triangle_angle >= 0.0 && max_edge_triangle_angle <= M_PI))
+    broken = "max_edge_triangle_angle must lie in [0, pi] rad";
+  if (broken) {
+    PCL_ERROR("[pcl::selective_seg::classifyTriangles] %s\n", broken);
+    labels.clear();
+    classes.clear();
+    return;
+  }
   const double cos_edge = std::cos(max_edge_triangle_angle);
   detail::assignLarge(labels, triangles.size(), 0);
   detail::assignLarge(classes, triangles.size(), TriangleClass::InvalidEdge);

@@ -382,6 +382,7 @@ runSelectiveLoop(const SimulationSetup& setup,
       r.score = score;
       observer(r);
     }
+    score.windows = scanned.size(); // the next score's step (none when it is empty)
     if (scanned.empty()) {
       // Nothing to refine, or the last round: done. Otherwise this round's share of
       // the budget fitted no window; the next round's share is larger.
@@ -389,7 +390,6 @@ runSelectiveLoop(const SimulationSetup& setup,
         break;
       continue;
     }
-    score.windows = scanned.size();
     score.scanned_solid_angle += solid_angle;
     window_points += static_cast<double>(fresh.size());
     window_candidates += estimated / yield;

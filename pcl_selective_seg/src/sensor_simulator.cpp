@@ -820,7 +820,7 @@ namespace {
 
 /** True when no hit had label 0; otherwise an error, and the cloud emptied. */
 bool
-unlabeledHitsRefused(const SimulationDetails& d,
+unlabeledHitsRefused(SimulationDetails& d,
                      pcl::PointCloud<pcl::PointXYZL>& cloud,
                      const char* method)
 {
@@ -834,6 +834,7 @@ unlabeledHitsRefused(const SimulationDetails& d,
   cloud.clear();
   cloud.width = 0;
   cloud.height = 1;
+  std::vector<double>().swap(d.exact_ranges); // one per point returned: none
   return false;
 }
 

@@ -141,7 +141,7 @@ PCL_EXPORTS bool delaunay2d(const std::vector<QuantizedPoint>& points,
  * both sides of the seam.
  *
  * \param[in] points distinct points with x in [-period / 2, period / 2), |y| <=
- *            kMaxDelaunayCoordinate - period / 64
+ *            kMaxDelaunayCoordinate - max(1, period / 64) (integer division)
  * \param[in] period an even number in [4, kMaxDelaunayCoordinate]
  * \param[in] backend BoostVoronoi or Sweep (an exact backend)
  * \param[out] triangles counter-clockwise, in canonical order (as delaunay2d())

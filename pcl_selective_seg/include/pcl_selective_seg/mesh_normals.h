@@ -25,7 +25,12 @@ using Vector3fVector = std::vector<Eigen::Vector3f>;
 // below the number of vertices the function is given (num_vertices, or the size of its
 // per-vertex arrays); per-triangle inputs have one entry per triangle; triangle ids
 // (changed triangles, old_to_new) are below the number of triangles or -1 where
-// documented. Broken inputs read or write out of bounds.
+// documented. Broken inputs read or write out of bounds: use these functions on meshes
+// made by SphericalDelaunay or delaunay2d(), or go through SelectiveSegmentation,
+// which checks everything it is given. Checked, with a
+// PCL_ERROR and empty outputs (in-place arrays left as they were): rings >= 1,
+// max_incidence >= 0 (not NaN), and the old arrays of updateTriangleNormalsAndEdgeOn()
+// one per old triangle.
 
 /** \brief Unit normal and 3-D area of each triangle (paper, Sec. III.B).
  *

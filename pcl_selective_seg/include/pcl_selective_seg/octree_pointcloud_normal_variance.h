@@ -75,8 +75,13 @@ using ScratchVector = std::vector<T, DefaultInitAllocator<T>>;
  * the sensor then sits near (0, 0) rather than at the +-pi seam. Deviations from the
  * voxel's angle are wrapped into (-pi, pi].
  *
- * The bounding box is taken from the points before insertion, so the tree, its leaves
- * and their order do not depend on the order of the points.
+ * The bounding box is taken from the points before insertion, so the tree, which
+ * points each leaf holds, and the leaves' order do not depend on the order of the
+ * points. A node's sums (eq. 3-5) run over its points in index order, so the same
+ * points in another order can give other last bits of a leaf's normal, area and
+ * sigmas (and, for a sigma within rounding of the threshold, another split). The
+ * segmentation gives the octree its vertices in a canonical order (sorted by angle),
+ * so its leaves do not depend on the order of the input cloud's points.
  *
  * Use: setInputCloud(), setInputNormals(), then addPointsFromInputCloud() and
  * computeAdaptiveLeaves() (which may run again with other thresholds), or
@@ -103,10 +108,10 @@ public:
   /** \param[in] resolution finest voxel edge [m], > 0 */
   explicit OctreePointCloudNormalVariance(double resolution);
 
-  /** \brief Per-point normals and point areas A_p (eq. 3), indexed like the input
-   * cloud. Points whose normal is not finite or is zero, or whose area is not
-   * positive (or so small that eq. 4's weight 1 / A_p overflows), are skipped by
-   * addPointsFromInputCloud(). */
+  /** \brief Per-point normals and point areas A_p (eq. 3), one of each per point of
+   * the input cloud (the insertion refuses other counts). Points whose normal is not
+   * finite or is zero, or whose area is not positive (or so small that eq. 4's weight
+   * 1 / A_p overflows), are skipped by addPointsFromInputCloud(). */
   void setInputNormals(const NormalCloudConstPtr& normals, const AreasConstPtr& areas);
 
   /** \brief The same with the normals as plain 3-vectors (12 bytes per point instead of
@@ -114,15 +119,18 @@ public:
   void setInputNormals(const NormalVectorsConstPtr& normals,
                        const AreasConstPtr& areas);
 
-  /** \brief Threads for the per-point work (0: defaultThreads()); the result does not
-   * depend on it. */
+  /** \brief Threads for the per-point work (0: defaultThreads(); at most 1,024); the
+   * result does not depend on it. */
   void setNumberOfThreads(unsigned int threads)
   {
-    num_threads_ = threads ? threads : defaultThreads();
+    num_threads_ = threads
+                       ? std::min(threads, static_cast<unsigned>(detail::kMaxThreads))
+                       : defaultThreads();
   }
 
   /** \brief Orientation of the sensor in the cloud frame (the angles of eq. 5 are
-   * measured in the sensor frame). Default: identity. */
+   * measured in the sensor frame), a unit quaternion. Default: identity. One that is
+   * not finite or is zero gives no leaves (computeAdaptiveLeaves()). */
   void setSensorOrientation(const Eigen::Quaternionf& orientation)
   {
     sensor_orientation_ = orientation;
@@ -142,15 +150,19 @@ public:
    * box in insertion order); into a tree that already holds points they are inserted
    * as PCL's octree does, its box kept or grown. A point is valid when it is finite,
    * its normal finite and not zero, and its area positive with a finite inverse (eq.
-   * 4's weight). \return false, with a PCL_ERROR when the resolution is not positive
-   * and finite or the points need more than kMaxDepth levels of it; false when no
-   * point is valid. */
+   * 4's weight). \return false, with a PCL_ERROR, when the resolution is not positive
+   * and finite, the normals or areas are missing or not one per point, an index names
+   * no point of the cloud, or the points need more than kMaxDepth levels of the
+   * resolution (into a tree that holds points: nothing is inserted when the grown box
+   * would need more); false when no point is valid or no cloud is set. */
   bool addPointsFromInputCloud();
 
   /** \brief Split from the root while sigma_theta or sigma_phi > max_std_dev [rad]
    * and the node holds at least min_points_to_split points (eq. 4-5). No leaves, with
-   * a PCL_ERROR, when the tree holds a point without a finite, non-zero normal and a
-   * positive area (one added by OctreePointCloud's own insertion methods). */
+   * a PCL_ERROR, when max_std_dev is not in (0, pi] (SelectiveSegmentationParameters'
+   * range), the sensor orientation is not finite or is zero, or the tree holds a
+   * point without a finite, non-zero normal and a positive area (one added by
+   * OctreePointCloud's own insertion methods). */
   void computeAdaptiveLeaves(double max_std_dev, std::size_t min_points_to_split);
 
   /** \brief addPointsFromInputCloud() then computeAdaptiveLeaves(): the same tree and

@@ -10,6 +10,7 @@
 
 #include <pcl/pcl_macros.h>
 
+#include <algorithm>
 #include <cstddef>
 #include <string>
 
@@ -50,12 +51,16 @@ PCL_EXPORTS void setHugePageAdviceThreshold(std::size_t bytes) noexcept;
 PCL_EXPORTS std::size_t getHugePageAdviceThreshold() noexcept;
 
 namespace detail {
+/** \brief Most threads any stage starts (the valid range of num_threads). */
+constexpr int kMaxThreads = 1024;
+
 /** \brief The threads of a parallel stage asked for \a requested: itself when
- * positive, else (0, automatic) defaultThreads(). */
+ * positive (at most kMaxThreads), else (0, automatic) defaultThreads(). */
 inline int
 threadCount(int requested)
 {
-  return requested > 0 ? requested : static_cast<int>(defaultThreads());
+  return requested > 0 ? std::min(requested, kMaxThreads)
+                       : static_cast<int>(defaultThreads());
 }
 } // namespace detail
 

@@ -105,8 +105,9 @@ struct MergeInput {
  * grows again in turn): the result is the one-thread result, bit for bit
  * (docs/performance_history.md, "Round 6").
  *
- * \param[in] input the seeds and the mesh. A missing array, or arrays whose sizes
- *            disagree, give a PCL_ERROR and empty outputs. Not checked (a pass over
+ * \param[in] input the seeds and the mesh. A missing array, arrays whose sizes
+ *            disagree, or an angle outside [0, pi] (NaN included), give a PCL_ERROR
+ *            and empty outputs. Not checked (a pass over
  *            the mesh, on the pipeline's path): every triangle's vertex ids are below
  *            \#V (vertex_leaf's size) and every vertex_leaf entry below \#L or -1.
  * \param[out] leaf_segment \#L segment id of each seed, 0..#S-1 in creation order
@@ -139,9 +140,14 @@ seedOrder(const std::vector<pcl::index_t>& vertex_leaf, std::size_t num_leaves);
  * \param[in] triangle_edge_on \#T 1 where seen edge-on (never a valid edge), or null
  * \param[in] vertex_labels \#V labels, 0 = unlabeled
  * \param[in] label_normals normal of label l at [l - 1]
- * \param[in] max_edge_triangle_angle [rad]
+ * \param[in] max_edge_triangle_angle [rad], in [0, pi]
  * \param[out] labels \#T labels (0 when no vertex is labeled)
  * \param[out] classes \#T classes
+ *
+ * Per-triangle arrays of another size, or an angle outside [0, pi] (NaN included),
+ * give a PCL_ERROR and empty outputs. Not checked (a pass over the mesh, on the
+ * pipeline's path): vertex ids below vertex_labels' size, and every vertex label at
+ * most label_normals' size.
  * \param[in] num_threads threads (0: defaultThreads()); the result does not
  *            depend on it
  */

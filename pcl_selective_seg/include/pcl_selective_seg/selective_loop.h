@@ -46,7 +46,9 @@ PCL_EXPORTS bool makeReferenceBoundary(const SimulationSetup& setup,
 /** \brief The scores of one segmented scan against the ground truth. */
 struct PCL_EXPORTS ScanScore {
   std::size_t points = 0;         ///< points acquired so far
-  std::size_t windows = 0;        ///< windows scanned in this step
+  /// Windows scanned in the step that led to this score: 1 for the coarse scan (the
+  /// whole view), then the windows the round before scanned (0 when it fitted none).
+  std::size_t windows = 0;
   double scanned_solid_angle = 0; ///< solid angle scanned so far, overlaps counted [sr]
   double seconds = 0.0; ///< computing time so far: segmentation, update, ROI [s]
   std::size_t segments = 0;

@@ -114,10 +114,12 @@ using LabelFunction = std::function<std::uint32_t(double s, double t)>;
  * with s, t in [0, 1] and n = (u x v) / |u x v|.
  *
  * Rays are intersected by sampling the signed height difference along the part of the
- * ray inside the panel's bounding prism at steps of at most \a max_step, then bisecting
- * the first sign change to double precision: the nearest crossing is found unless the
- * ray enters and leaves the surface within one step (a feature thinner than
- * \a max_step along the ray) or only touches it. Different regions may carry
+ * ray inside the panel's bounding prism at steps of at most \a max_step (at most a
+ * million steps: beyond 10^6 max_step inside the prism, 2 km at the default, the
+ * steps grow to span / 10^6), then bisecting the first sign change to double
+ * precision: the nearest crossing is found unless the ray enters and leaves the
+ * surface within one step (a feature thinner than a step along the ray) or only
+ * touches it. Different regions may carry
  * different labels (a dent in a door panel, for example).
  */
 struct HeightField {

@@ -143,7 +143,9 @@ public:
    * teams of tens of thousands). The result does not depend on it. */
   void setNumberOfThreads(unsigned int threads)
   {
-    num_threads_ = threads ? std::min(threads, 1024u) : defaultThreads();
+    num_threads_ = threads
+                       ? std::min(threads, static_cast<unsigned>(detail::kMaxThreads))
+                       : defaultThreads();
   }
 
   /** \brief Sensor pose in the cloud frame, overriding the cloud's sensor_origin_ /

@@ -149,8 +149,18 @@ bool
 OctreePointCloudNormalVariance<PointT>::insertPoints(bool with_angles)
 {
   angles_ready_ = false;
-  if (!this->input_ || !hasNormalsAndAreas())
+  if (!this->input_)
+    return false; // PCL's octree inserts nothing without a cloud either
+  if (!hasNormalsAndAreas() || numInputNormals() != this->input_->size() ||
+      areas_->size() != this->input_->size()) {
+    PCL_ERROR("[pcl::selective_seg::OctreePointCloudNormalVariance] %zu points, but "
+              "%zu normals and %zu areas: give one of each per point of the input "
+              "cloud with setInputNormals()\n",
+              static_cast<std::size_t>(this->input_->size()),
+              hasNormalsAndAreas() ? numInputNormals() : std::size_t{0},
+              areas_ ? areas_->size() : std::size_t{0});
     return false;
+  }
   if (!(this->resolution_ > 0.0) || !std::isfinite(this->resolution_)) {
     PCL_ERROR("[pcl::selective_seg::OctreePointCloudNormalVariance] the resolution "
               "(smallest voxel) is %g: it must be positive and finite\n",
@@ -168,8 +178,9 @@ OctreePointCloudNormalVariance<PointT>::insertPoints(bool with_angles)
   detail::resizeLarge(is_valid, static_cast<std::size_t>(num_candidates));
   Eigen::Array3d lo = Eigen::Array3d::Constant(std::numeric_limits<double>::max());
   Eigen::Array3d hi = -lo;
+  std::size_t beyond_cloud = 0; // indices that name no point of the cloud
 #ifdef _OPENMP
-#pragma omp parallel num_threads(num_threads_)                                        \
+#pragma omp parallel num_threads(num_threads_) reduction(+ : beyond_cloud)           \
     if (static_cast<std::size_t>(num_candidates) >= detail::kMinParallelItems)
 #endif
   {
@@ -179,6 +190,7 @@ OctreePointCloudNormalVariance<PointT>::insertPoints(bool with_angles)
 #endif
     for (std::ptrdiff_t k = 0; k < num_candidates; ++k) {
       const pcl::index_t i = candidate(k);
+      beyond_cloud += static_cast<std::size_t>(i) >= this->input_->size();
       is_valid[k] = isValidPoint(i);
       if (is_valid[k]) {
         const Eigen::Array3d p =
@@ -203,13 +215,38 @@ OctreePointCloudNormalVariance<PointT>::insertPoints(bool with_angles)
     if (is_valid[k])
       valid.push_back(candidate(k));
   std::vector<std::uint8_t>().swap(is_valid);
+  if (beyond_cloud != 0) {
+    PCL_ERROR("[pcl::selective_seg::OctreePointCloudNormalVariance] %zu of the %zu "
+              "indices name no point of the cloud (%zu points): nothing was inserted\n",
+              beyond_cloud,
+              static_cast<std::size_t>(num_candidates),
+              static_cast<std::size_t>(this->input_->size()));
+    return false;
+  }
   if (valid.empty())
     return false;
   if (!std::is_sorted(valid.begin(), valid.end()))
     std::sort(valid.begin(), valid.end());
   if (this->leaf_count_ != 0) {
     // A tree that already holds points keeps its box: PCL's insertion, point by point
-    // (it grows the box as PCL's octree does).
+    // (it grows the box as PCL's octree does, a level at a time). Refused before it
+    // starts when the grown box would need more than kMaxDepth levels: PCL would add
+    // levels until its memory or its 32-bit depth arithmetic gave out.
+    double box[6];
+    this->getBoundingBox(box[0], box[1], box[2], box[3], box[4], box[5]);
+    const Eigen::Array3d box_lo(box[0], box[1], box[2]), box_hi(box[3], box[4], box[5]);
+    const double reach = (hi.max(box_hi) - lo.min(box_lo)).maxCoeff();
+    if (!(reach <= std::ldexp(this->resolution_, static_cast<int>(kMaxDepth)))) {
+      PCL_ERROR("[pcl::selective_seg::OctreePointCloudNormalVariance] the new points "
+                "and the tree span %g m, more than %u levels of %g voxels; at most %u "
+                "are supported: nothing was inserted (a coarser resolution is "
+                "needed)\n",
+                reach,
+                kMaxDepth,
+                this->resolution_,
+                kMaxDepth);
+      return false;
+    }
     for (const auto i : valid)
       this->addPointIdx(i);
     return checkDepth();
@@ -572,6 +609,21 @@ OctreePointCloudNormalVariance<PointT>::computeAdaptiveLeaves(
     releaseScratch();
   }
   if (this->leaf_count_ == 0 || !this->root_node_ || !checkDepth()) {
+    releaseScratch();
+    return;
+  }
+  // The same ranges as SelectiveSegmentationParameters::validate().
+  const bool threshold_ok = max_std_dev > 0.0 && max_std_dev <= M_PI;
+  const bool orientation_ok = sensor_orientation_.coeffs().allFinite() &&
+                              sensor_orientation_.coeffs().squaredNorm() > 0.0f;
+  if (!threshold_ok || !orientation_ok) {
+    if (!threshold_ok)
+      PCL_ERROR("[pcl::selective_seg::OctreePointCloudNormalVariance] the split "
+                "threshold is %g rad: it must lie in (0, pi]; no leaves\n",
+                max_std_dev);
+    else
+      PCL_ERROR("[pcl::selective_seg::OctreePointCloudNormalVariance] the sensor "
+                "orientation is not a finite, non-zero quaternion; no leaves\n");
     releaseScratch();
     return;
   }
