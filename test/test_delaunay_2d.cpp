@@ -542,6 +542,16 @@ sweepMatchesBoost(const Points& points)
 
 } // namespace
 
+TEST(TriangleNeighbours, VertexIdsBeyondTheCountAreRefused)
+{
+  std::vector<pcl::selective_seg::Triangle> neighbours{{0, 0, 0}};
+  pcl::selective_seg::computeTriangleNeighbours({{0, 1, 100000000}}, 3, neighbours);
+  EXPECT_TRUE(neighbours.empty());
+  pcl::selective_seg::computeTriangleNeighbours({{0, 1, 2}, {2, 1, 3}}, 4, neighbours);
+  ASSERT_EQ(neighbours.size(), 2u);
+  EXPECT_EQ(neighbours[0][0], 1); // the edge 1-2 opposite vertex 0
+}
+
 TEST(DelaunayBackend, NamesAndAvailability)
 {
   EXPECT_STREQ(pcl::selective_seg::toString(DelaunayBackend::BoostVoronoi), "boost");

@@ -8,15 +8,17 @@
 
 #include <pcl_selective_seg/delaunay_2d.h>
 #include <pcl_selective_seg/mesh_normals.h>
+#include <pcl_selective_seg/parameters.h>
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <numeric>
 #include <limits>
+#include <numeric>
 #include <random>
+#include <thread>
 #include <vector>
 
 using pcl::selective_seg::computeTriangleNormals;
@@ -410,6 +412,112 @@ TEST(MeshNormals, UnusableRingsOrIncidenceAreRefused)
   std::vector<std::uint8_t> edge_on;
   markEdgeOnTriangles(positions, tris, n, Eigen::Vector3f::Zero(), 0.5, edge_on);
   EXPECT_EQ(edge_on.size(), 2u);
+}
+
+// A triangle naming a vertex beyond the arrays (or triangle ids beyond the mesh) is
+// refused with a message, not read out of bounds: empty outputs, in-place arrays as
+// they were.
+TEST(MeshNormals, IdsBeyondTheArraysAreRefused)
+{
+  using namespace pcl::selective_seg;
+  const Vector3fVector positions{Eigen::Vector3f(0, 0, 5),
+                                 Eigen::Vector3f(1, 0, 5),
+                                 Eigen::Vector3f(0, 1, 5),
+                                 Eigen::Vector3f(1, 1, 5)};
+  const std::vector<Triangle> good{{0, 1, 2}, {1, 3, 2}};
+  for (const pcl::index_t bad_id :
+       {pcl::index_t{4}, pcl::index_t{100000000}, pcl::index_t{-1}}) {
+    SCOPED_TRACE(bad_id);
+    const std::vector<Triangle> bad{{0, 1, 2}, {1, bad_id, 2}};
+    Vector3fVector normals(7);
+    std::vector<double> areas(7);
+    std::vector<std::uint8_t> edge_on(7);
+    computeTriangleNormals(positions, bad, Eigen::Vector3f::Zero(), normals, areas);
+    EXPECT_TRUE(normals.empty() && areas.empty());
+    computeTriangleNormalsAndEdgeOn(
+        positions, bad, Eigen::Vector3f::Zero(), 1.4, normals, areas, edge_on);
+    EXPECT_TRUE(normals.empty() && areas.empty() && edge_on.empty());
+    const Vector3fVector n(2, Eigen::Vector3f(0, 0, -1));
+    const std::vector<double> a(2, 0.5);
+    edge_on.assign(3, 1);
+    markEdgeOnTriangles(positions, bad, n, Eigen::Vector3f::Zero(), 1.4, edge_on);
+    EXPECT_TRUE(edge_on.empty());
+    Vector3fVector vertex_normals(3);
+    std::vector<double> vertex_areas(3);
+    computeVertexNormals(4, bad, n, a, vertex_normals, vertex_areas);
+    EXPECT_TRUE(vertex_normals.empty() && vertex_areas.empty());
+    vertex_normals.assign(3, Eigen::Vector3f::Zero());
+    computeVertexNormalsOverRings(4, bad, n, a, 2, vertex_normals);
+    EXPECT_TRUE(vertex_normals.empty());
+    Vector3fVector missing(4, Eigen::Vector3f::Constant(NAN));
+    EXPECT_EQ(fillMissingVertexNormals(bad, n, a, 1, missing), 0u);
+    Vector3fVector from_vertices(5);
+    computeTriangleNormalsFromVertices(bad, missing, from_vertices);
+    EXPECT_TRUE(from_vertices.empty());
+    EXPECT_TRUE(std::isnan(medianEdgeLength(positions, bad)));
+    // In place: the arrays stay as they were.
+    Vector3fVector kept(4, Eigen::Vector3f(0, 0, -1));
+    std::vector<double> kept_areas(4, 1.0);
+    const std::vector<Triangle> no_neighbours(2, Triangle{-1, -1, -1});
+    updateVertexNormals(bad, no_neighbours, n, a, {1}, kept, kept_areas);
+    updateVertexNormalsOverRings(bad, no_neighbours, n, a, 2, {1}, kept);
+    EXPECT_EQ(kept, Vector3fVector(4, Eigen::Vector3f(0, 0, -1)));
+    EXPECT_EQ(kept_areas, std::vector<double>(4, 1.0));
+  }
+  // Triangle ids beyond the mesh in the update functions' lists.
+  const Vector3fVector n(2, Eigen::Vector3f(0, 0, -1));
+  const std::vector<double> a(2, 0.5);
+  Vector3fVector kept(4, Eigen::Vector3f(0, 0, -1));
+  std::vector<double> kept_areas(4, 1.0);
+  const std::vector<Triangle> no_neighbours(2, Triangle{-1, -1, -1});
+  updateVertexNormals(good, no_neighbours, n, a, {7}, kept, kept_areas);
+  updateVertexNormals(good, {{-1, -1, 9}, {-1, -1, -1}}, n, a, {1}, kept, kept_areas);
+  EXPECT_EQ(kept, Vector3fVector(4, Eigen::Vector3f(0, 0, -1)));
+  Vector3fVector old_normals(2, Eigen::Vector3f(0, 0, -1));
+  std::vector<double> old_areas(2, 0.5);
+  std::vector<std::uint8_t> old_flags(2, 0);
+  updateTriangleNormalsAndEdgeOn(positions,
+                                 good,
+                                 Eigen::Vector3f::Zero(),
+                                 1.4,
+                                 {0, 5},
+                                 {1},
+                                 old_normals,
+                                 old_areas,
+                                 old_flags);
+  EXPECT_EQ(old_normals.size(), 2u);
+  EXPECT_EQ(old_areas, std::vector<double>(2, 0.5));
+  // The same calls on the good mesh do their work.
+  Vector3fVector normals;
+  std::vector<double> areas;
+  computeTriangleNormals(positions, good, Eigen::Vector3f::Zero(), normals, areas);
+  EXPECT_EQ(normals.size(), 2u);
+  EXPECT_NEAR(medianEdgeLength(positions, good), 1.0, 1e-6);
+}
+
+// The pipeline's scope that skips the id checks (its meshes meet them by
+// construction) lives on its thread only, nests, and ends with the run.
+TEST(MeshNormals, TrustedMeshScopeIsThreadLocalAndNests)
+{
+  using namespace pcl::selective_seg;
+  EXPECT_FALSE(detail::meshTrusted());
+  {
+    const detail::TrustedMeshScope outer;
+    EXPECT_TRUE(detail::meshTrusted());
+    {
+      const detail::TrustedMeshScope inner;
+      EXPECT_TRUE(detail::meshTrusted());
+    }
+    EXPECT_TRUE(detail::meshTrusted());
+    bool other_thread = true;
+    std::thread([&] { other_thread = detail::meshTrusted(); }).join();
+    EXPECT_FALSE(other_thread);
+  }
+  EXPECT_FALSE(detail::meshTrusted());
+  // Outside the scope a broken mesh is refused (IdsBeyondTheArraysAreRefused).
+  std::vector<Triangle> neighbours{{0, 0, 0}};
+  computeTriangleNeighbours({{0, 1, 7}}, 3, neighbours);
+  EXPECT_TRUE(neighbours.empty());
 }
 
 TEST(MeshNormals, EdgeOnThreshold)

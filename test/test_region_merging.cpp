@@ -203,7 +203,13 @@ TEST(MergeSeedSegments, MissingOrMismatchedArraysGiveEmptyOutputs)
   const MergeInput good = strip.input();
   Vector3fVector one_normal(1, Eigen::Vector3f(0.f, 0.f, -1.f));
   std::vector<std::uint8_t> short_flags(1, 0);
-  std::vector<MergeInput> bad(9, good);
+  std::vector<pcl::index_t> far_leaf = *good.vertex_leaf;
+  far_leaf.back() = 100000000;
+  std::vector<Triangle> far_vertex = *good.triangles;
+  far_vertex.back()[2] = 100000000;
+  std::vector<MergeInput> bad(11, good);
+  bad[9].vertex_leaf = &far_leaf;
+  bad[10].triangles = &far_vertex;
   bad[0].vertex_leaf = nullptr;
   bad[1].triangles = nullptr;
   bad[2].leaf_areas = nullptr;
@@ -762,6 +768,43 @@ TEST(ClassifyTriangles, MismatchedArraysOrAnglesGiveEmptyOutputs)
   EXPECT_EQ(classify(normals, &one_flag, 25.0 * kDeg), 0u);
   EXPECT_EQ(classify(normals, nullptr, std::numeric_limits<double>::quiet_NaN()), 0u);
   EXPECT_EQ(classify(normals, nullptr, -1.0), 0u);
+}
+
+// Ids beyond the arrays they index are refused with a message, not read out of
+// bounds: a triangle's vertex beyond vertex_labels / vertex_leaf, a leaf beyond the
+// leaves, a label without a normal, a group beyond the groups.
+TEST(ClassifyTriangles, IdsBeyondTheArraysAreRefused)
+{
+  const Vector3fVector label_normals{tilted(0.0), tilted(40.0)};
+  const Vector3fVector normals{tilted(0.0), tilted(30.0)};
+  std::vector<std::uint32_t> labels{9};
+  std::vector<TriangleClass> classes{TriangleClass::Interior};
+  classifyTriangles({{0, 1, 2}, {0, 1, 100000000}},
+                    normals,
+                    nullptr,
+                    {1, 1, 1, 2},
+                    label_normals,
+                    25.0 * kDeg,
+                    labels,
+                    classes);
+  EXPECT_TRUE(labels.empty() && classes.empty());
+  classifyTriangles({{0, 1, 2}, {0, 1, 3}},
+                    normals,
+                    nullptr,
+                    {1, 1, 1, 3}, // label 3 has no normal
+                    label_normals,
+                    25.0 * kDeg,
+                    labels,
+                    classes);
+  EXPECT_TRUE(labels.empty() && classes.empty());
+  EXPECT_TRUE(seedOrder({0, 1, 100000000}, 2).empty());
+  EXPECT_EQ(seedOrder({0, 1, 1, -1}, 2), (std::vector<pcl::index_t>{1, 0}));
+  const Incidence bad = vertexTriangles({{0, 1, 5}}, 3);
+  EXPECT_EQ(bad.offsets, (std::vector<std::size_t>(4, 0)));
+  EXPECT_TRUE(bad.items.empty());
+  const Incidence groups = Incidence::build({0, 7, -1}, 2);
+  EXPECT_EQ(groups.offsets, (std::vector<std::size_t>(3, 0)));
+  EXPECT_TRUE(groups.items.empty());
 }
 
 TEST(ClassifyTriangles, InteriorIgnoresNormal)

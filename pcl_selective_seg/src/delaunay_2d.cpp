@@ -18,6 +18,7 @@
 
 #include "delaunay_2d_backends.h"
 #include "incidence_build.h"
+#include "mesh_checks.h"
 
 namespace pcl {
 namespace selective_seg {
@@ -750,6 +751,15 @@ computeTriangleNeighbours(const std::vector<Triangle>& triangles,
                           std::vector<Triangle>& neighbours,
                           unsigned int num_threads)
 {
+  if (!detail::idsBelow(triangles,
+                        num_vertices,
+                        false,
+                        "computeTriangleNeighbours",
+                        "the triangles",
+                        static_cast<int>(num_threads))) {
+    neighbours.clear();
+    return;
+  }
   // Bucket the half-edges by their origin vertex (compressed rows), each stored as
   // (end vertex, triangle). The half-edge opposite corner i of triangle t runs from
   // t[(i + 1) % 3] to t[(i + 2) % 3]; its twin is the half-edge leaving t[(i + 2) % 3]

@@ -10,6 +10,8 @@
 #include <pcl_selective_seg/region_merging.h>
 #include <pcl_selective_seg/spherical_delaunay.h>
 
+#include "mesh_checks.h"
+
 #ifdef _OPENMP
 #include <omp.h>
 #endif
@@ -228,6 +230,17 @@ computeTriangleNormals(const Vector3fVector& positions,
                        std::vector<double>& areas,
                        int num_threads)
 {
+  // The ids and sizes the passes below index with (mesh_checks.h).
+  if (!detail::idsBelow(triangles,
+                        positions.size(),
+                        false,
+                        "computeTriangleNormals",
+                        "the triangles",
+                        num_threads)) {
+    normals.clear();
+    areas.clear();
+    return;
+  }
   const float nan = std::numeric_limits<float>::quiet_NaN();
   detail::assignLarge(normals, triangles.size(), Eigen::Vector3f::Constant(nan));
   detail::assignLarge(areas, triangles.size(), 0.0);
@@ -248,7 +261,14 @@ computeTriangleNormalsAndEdgeOn(const Vector3fVector& positions,
                                 std::vector<std::uint8_t>& edge_on,
                                 int num_threads)
 {
-  if (!incidenceUsable(max_incidence, "computeTriangleNormalsAndEdgeOn")) {
+  // The ids and sizes the passes below index with (mesh_checks.h).
+  if (!detail::idsBelow(triangles,
+                        positions.size(),
+                        false,
+                        "computeTriangleNormalsAndEdgeOn",
+                        "the triangles",
+                        num_threads) ||
+      !incidenceUsable(max_incidence, "computeTriangleNormalsAndEdgeOn")) {
     normals.clear();
     areas.clear();
     edge_on.clear();
@@ -279,6 +299,15 @@ updateTriangleNormalsAndEdgeOn(const Vector3fVector& positions,
                                std::vector<std::uint8_t>& edge_on,
                                int num_threads)
 {
+  // The ids and sizes the passes below index with (mesh_checks.h).
+  const char* where = "updateTriangleNormalsAndEdgeOn";
+  if (!detail::idsBelow(
+          triangles, positions.size(), false, where, "the triangles", num_threads) ||
+      !detail::idsBelow(
+          old_to_new, triangles.size(), true, where, "old_to_new", num_threads) ||
+      !detail::idsBelow(
+          changed, triangles.size(), false, where, "changed", num_threads))
+    return; // the arrays as they were
   if (!incidenceUsable(max_incidence, "updateTriangleNormalsAndEdgeOn") ||
       normals.size() != old_to_new.size() || areas.size() != old_to_new.size() ||
       edge_on.size() != old_to_new.size()) {
@@ -561,6 +590,17 @@ computeVertexNormals(std::size_t num_vertices,
                      int num_threads,
                      const std::vector<Triangle>* neighbours)
 {
+  // The ids and sizes the passes below index with (mesh_checks.h).
+  const char* where = "computeVertexNormals";
+  if (!detail::trianglesWithValuesFit(
+          triangles, num_vertices, normals.size(), areas.size(), where, num_threads) ||
+      (neighbours && neighbours->size() == triangles.size() &&
+       !detail::idsBelow(
+           *neighbours, triangles.size(), true, where, "neighbours", num_threads))) {
+    vertex_normals.clear();
+    vertex_areas.clear();
+    return;
+  }
   const bool adjacency = neighbours && neighbours->size() == triangles.size();
   if (scatterVertexNormals(num_vertices,
                            triangles,
@@ -685,7 +725,11 @@ computeVertexNormalsOverRings(std::size_t num_vertices,
                               int rings,
                               Vector3fVector& vertex_normals)
 {
-  if (!ringsUsable(rings, "computeVertexNormalsOverRings")) {
+  // The ids and sizes the passes below index with (mesh_checks.h).
+  const char* where = "computeVertexNormalsOverRings";
+  if (!detail::trianglesWithValuesFit(
+          triangles, num_vertices, normals.size(), areas.size(), where) ||
+      !ringsUsable(rings, where)) {
     vertex_normals.clear();
     return;
   }
@@ -709,6 +753,15 @@ updateVertexNormalsOverRings(const std::vector<Triangle>& triangles,
                              const std::vector<pcl::index_t>& changed_triangles,
                              Vector3fVector& vertex_normals)
 {
+  // The ids and sizes the passes below index with (mesh_checks.h).
+  const char* where = "updateVertexNormalsOverRings";
+  if (!detail::trianglesWithValuesFit(
+          triangles, vertex_normals.size(), normals.size(), areas.size(), where) ||
+      !detail::sizeIs(neighbours.size(), triangles.size(), where, "neighbours") ||
+      !detail::idsBelow(neighbours, triangles.size(), true, where, "neighbours") ||
+      !detail::idsBelow(
+          changed_triangles, triangles.size(), false, where, "changed_triangles"))
+    return; // the normals as they were
   if (!ringsUsable(rings, "updateVertexNormalsOverRings"))
     return; // the normals as they were
   // One triangle at each vertex met, for the walks around it.
@@ -758,6 +811,10 @@ maskEdgeOnNormals(const Vector3fVector& normals,
                   Vector3fVector& masked,
                   int num_threads)
 {
+  if (!detail::sizeIs(edge_on.size(), normals.size(), "maskEdgeOnNormals", "edge_on")) {
+    masked.clear();
+    return;
+  }
   const Eigen::Vector3f nan =
       Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN());
   detail::resizeLarge(masked, normals.size());
@@ -776,6 +833,15 @@ fillMissingVertexNormals(const std::vector<Triangle>& triangles,
                          Vector3fVector& vertex_normals,
                          int num_threads)
 {
+  // The ids and sizes the passes below index with (mesh_checks.h).
+  const char* where = "fillMissingVertexNormals";
+  if (!detail::trianglesWithValuesFit(triangles,
+                                      vertex_normals.size(),
+                                      normals.size(),
+                                      areas.size(),
+                                      where,
+                                      num_threads))
+    return 0; // the normals as they were
   if (!ringsUsable(rings, "fillMissingVertexNormals"))
     return 0; // the normals as they were
   const std::size_t num_vertices = vertex_normals.size();
@@ -820,6 +886,15 @@ computeTriangleNormalsFromVertices(const std::vector<Triangle>& triangles,
                                    const Vector3fVector& vertex_normals,
                                    Vector3fVector& normals)
 {
+  // The ids and sizes the passes below index with (mesh_checks.h).
+  if (!detail::idsBelow(triangles,
+                        vertex_normals.size(),
+                        false,
+                        "computeTriangleNormalsFromVertices",
+                        "the triangles")) {
+    normals.clear();
+    return;
+  }
   normals.resize(triangles.size());
   for (std::size_t t = 0; t < triangles.size(); ++t) {
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
@@ -841,7 +916,16 @@ markEdgeOnTriangles(const Vector3fVector& positions,
                     std::vector<std::uint8_t>& edge_on,
                     int num_threads)
 {
-  if (!incidenceUsable(max_incidence, "markEdgeOnTriangles")) {
+  // The ids and sizes the passes below index with (mesh_checks.h).
+  if (!detail::idsBelow(triangles,
+                        positions.size(),
+                        false,
+                        "markEdgeOnTriangles",
+                        "the triangles",
+                        num_threads) ||
+      !detail::sizeIs(
+          normals.size(), triangles.size(), "markEdgeOnTriangles", "normals") ||
+      !incidenceUsable(max_incidence, "markEdgeOnTriangles")) {
     edge_on.clear();
     return;
   }
@@ -864,6 +948,22 @@ updateVertexNormals(const std::vector<Triangle>& triangles,
                     std::vector<double>& vertex_areas,
                     int num_threads)
 {
+  // The ids and sizes the passes below index with (mesh_checks.h).
+  const char* where = "updateVertexNormals";
+  if (!detail::trianglesWithValuesFit(triangles,
+                                      vertex_normals.size(),
+                                      normals.size(),
+                                      areas.size(),
+                                      where,
+                                      num_threads) ||
+      !detail::sizeIs(
+          vertex_areas.size(), vertex_normals.size(), where, "vertex_areas") ||
+      !detail::sizeIs(neighbours.size(), triangles.size(), where, "neighbours") ||
+      !detail::idsBelow(
+          neighbours, triangles.size(), true, where, "neighbours", num_threads) ||
+      !detail::idsBelow(
+          changed_triangles, triangles.size(), false, where, "changed_triangles"))
+    return; // the normals as they were
   // The vertices of the changed triangles, each with one of them.
   std::vector<std::pair<pcl::index_t, pcl::index_t>> touched; // (vertex, triangle)
   touched.reserve(3 * changed_triangles.size());
@@ -885,6 +985,14 @@ medianEdgeLength(const Vector3fVector& positions,
                  const std::vector<Triangle>& triangles,
                  int num_threads)
 {
+  // The ids and sizes the passes below index with (mesh_checks.h).
+  if (!detail::idsBelow(triangles,
+                        positions.size(),
+                        false,
+                        "medianEdgeLength",
+                        "the triangles",
+                        num_threads))
+    return std::numeric_limits<double>::quiet_NaN();
   if (triangles.empty())
     return 0.0;
   // Large meshes: every stride-th triangle (a fixed function of the canonical triangle

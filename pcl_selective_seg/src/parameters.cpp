@@ -19,6 +19,29 @@
 namespace pcl {
 namespace selective_seg {
 
+namespace detail {
+namespace {
+thread_local bool mesh_trusted = false;
+} // namespace
+
+TrustedMeshScope::TrustedMeshScope() noexcept
+    : previous_(mesh_trusted)
+{
+  mesh_trusted = true;
+}
+
+TrustedMeshScope::~TrustedMeshScope()
+{
+  mesh_trusted = previous_;
+}
+
+bool
+meshTrusted() noexcept
+{
+  return mesh_trusted;
+}
+} // namespace detail
+
 unsigned int
 defaultThreads()
 {

@@ -17,6 +17,7 @@
 #include <numeric>
 
 #include "incidence_build.h"
+#include "mesh_checks.h"
 
 namespace pcl {
 namespace selective_seg {
@@ -24,6 +25,8 @@ namespace selective_seg {
 Incidence
 Incidence::build(const std::vector<pcl::index_t>& group_of, std::size_t num_groups)
 {
+  if (!detail::idsBelow(group_of, num_groups, true, "Incidence::build", "group_of"))
+    return {std::vector<std::size_t>(num_groups + 1, 0), {}}; // every group empty
   return detail::buildIncidence(group_of.size(), num_groups, [&](std::size_t i, auto f) {
     if (group_of[i] >= 0)
       f(group_of[i]);
@@ -61,6 +64,13 @@ vertexTriangles(const std::vector<Triangle>& triangles,
                 std::size_t num_vertices,
                 int num_threads)
 {
+  if (!detail::idsBelow(triangles,
+                        num_vertices,
+                        false,
+                        "vertexTriangles",
+                        "the triangles",
+                        num_threads))
+    return {std::vector<std::size_t>(num_vertices + 1, 0), {}}; // every group empty
   return detail::buildIncidence(
       triangles.size(),
       num_vertices,
@@ -729,6 +739,8 @@ private:
 std::vector<pcl::index_t>
 seedOrder(const std::vector<pcl::index_t>& vertex_leaf, std::size_t num_leaves)
 {
+  if (!detail::idsBelow(vertex_leaf, num_leaves, true, "seedOrder", "vertex_leaf"))
+    return {};
   std::vector<std::uint32_t> size(num_leaves, 0);
   std::uint32_t largest = 0;
   for (const auto l : vertex_leaf)
@@ -767,6 +779,19 @@ mergeSeedSegments(const MergeInput& input,
            !(input.max_edge_triangle_angle >= 0.0 &&
              input.max_edge_triangle_angle <= M_PI))
     missing = "max_merge_angle and max_edge_triangle_angle must lie in [0, pi] rad";
+  else if (!detail::idsBelow(*input.triangles,
+                             input.vertex_leaf->size(),
+                             false,
+                             "mergeSeedSegments",
+                             "the triangles",
+                             input.num_threads) ||
+           !detail::idsBelow(*input.vertex_leaf,
+                             numLeaves(input),
+                             true,
+                             "mergeSeedSegments",
+                             "vertex_leaf",
+                             input.num_threads))
+    missing = "the mesh's ids do not fit its arrays (above)";
   if (missing) {
     PCL_ERROR("[pcl::selective_seg::mergeSeedSegments] %s\n", missing);
     leaf_segment.clear();
@@ -796,6 +821,17 @@ classifyTriangles(const std::vector<Triangle>& triangles,
     broken = "triangle_normals (and triangle_edge_on) need one entry per triangle";
   else if (!(max_edge_triangle_angle >= 0.0 && max_edge_triangle_angle <= M_PI))
     broken = "max_edge_triangle_angle must lie in [0, pi] rad";
+  else if (!detail::idsBelow(triangles,
+                             vertex_labels.size(),
+                             false,
+                             "classifyTriangles",
+                             "the triangles",
+                             num_threads))
+    broken = "the triangles' vertex ids do not fit vertex_labels (above)";
+  else if (!vertex_labels.empty() &&
+           *std::max_element(vertex_labels.begin(), vertex_labels.end()) >
+               label_normals.size())
+    broken = "a vertex label has no normal in label_normals (label l at [l - 1])";
   if (broken) {
     PCL_ERROR("[pcl::selective_seg::classifyTriangles] %s\n", broken);
     labels.clear();

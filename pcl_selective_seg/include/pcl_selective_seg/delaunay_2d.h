@@ -171,6 +171,7 @@ PCL_EXPORTS bool delaunay2dPeriodic(const std::vector<QuantizedPoint>& points,
  * neighbours[t][i] is the triangle sharing the edge opposite vertex i of triangle t
  * (the edge triangles[t][(i+1)%3] - triangles[t][(i+2)%3]), or -1 on the boundary.
  * \param[in] num_threads threads for the lookups (the result does not depend on it).
+ * A vertex id not below num_vertices gives a PCL_ERROR and no neighbours.
  */
 PCL_EXPORTS void computeTriangleNeighbours(const std::vector<Triangle>& triangles,
                                            std::size_t num_vertices,

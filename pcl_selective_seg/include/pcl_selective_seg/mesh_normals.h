@@ -20,17 +20,17 @@ namespace selective_seg {
 /** \brief 3-vectors (Eigen::Vector3f needs no aligned allocator). */
 using Vector3fVector = std::vector<Eigen::Vector3f>;
 
-// Preconditions of every function below, not checked (each would cost a pass over the
-// mesh on the pipeline's path, whose arrays meet them): a triangle's vertex ids are
-// below the number of vertices the function is given (num_vertices, or the size of its
-// per-vertex arrays); per-triangle inputs have one entry per triangle; triangle ids
-// (changed triangles, old_to_new) are below the number of triangles or -1 where
-// documented. Broken inputs read or write out of bounds: use these functions on meshes
-// made by SphericalDelaunay or delaunay2d(), or go through SelectiveSegmentation,
-// which checks everything it is given. Checked, with a
-// PCL_ERROR and empty outputs (in-place arrays left as they were): rings >= 1,
-// max_incidence >= 0 (not NaN), and the old arrays of updateTriangleNormalsAndEdgeOn()
-// one per old triangle.
+// Inputs every function below checks, with a PCL_ERROR and empty outputs (in-place
+// arrays left as they were; medianEdgeLength() gives NaN) when they do not hold: a
+// triangle's vertex ids are below the number of vertices the function is given
+// (num_vertices, or the size of its per-vertex arrays); per-triangle inputs have one
+// entry per triangle; triangle ids (changed triangles, old_to_new, neighbours) are
+// below the number of triangles, or negative (none) where documented; rings >= 1;
+// max_incidence >= 0 (not NaN). The id checks are one pass over the ids, on both
+// cores for large meshes (about 0.03 ms for 90,000 triangles, 0.7 ms for 2 million);
+// SelectiveSegmentation skips them on its own meshes (detail::TrustedMeshScope).
+// Not checked: the values themselves (NaN positions or normals give NaN results, as
+// documented for each function).
 
 /** \brief Unit normal and 3-D area of each triangle (paper, Sec. III.B).
  *
@@ -243,7 +243,8 @@ updateVertexNormalsOverRings(const std::vector<Triangle>& triangles,
 
 /** \brief Median 3-D length of the triangles' edges [m] (each interior edge counted
  * twice; over 100,000 triangles, those of every stride-th triangle, stride =
- * triangles / 100,000); 0 for an empty mesh. The octree's automatic minimum voxel size
+ * triangles / 100,000); 0 for an empty mesh, NaN (with a PCL_ERROR) for a triangle
+ * naming a vertex beyond the positions. The octree's automatic minimum voxel size
  * scales it. Threads: 0 = defaultThreads(); the result does not depend on them. */
 PCL_EXPORTS double medianEdgeLength(const Vector3fVector& positions,
                                     const std::vector<Triangle>& triangles,

@@ -106,10 +106,9 @@ struct MergeInput {
  * (docs/performance_history.md, "Round 6").
  *
  * \param[in] input the seeds and the mesh. A missing array, arrays whose sizes
- *            disagree, or an angle outside [0, pi] (NaN included), give a PCL_ERROR
- *            and empty outputs. Not checked (a pass over
- *            the mesh, on the pipeline's path): every triangle's vertex ids are below
- *            \#V (vertex_leaf's size) and every vertex_leaf entry below \#L or -1.
+ *            disagree, an angle outside [0, pi] (NaN included), a triangle's vertex id
+ *            not below \#V (vertex_leaf's size) or a vertex_leaf entry not below \#L
+ *            (negative: no leaf) give a PCL_ERROR and empty outputs.
  * \param[out] leaf_segment \#L segment id of each seed, 0..#S-1 in creation order
  * \param[out] segment_normals \#S unit segment normals N_S (eq. 7)
  */
@@ -123,6 +122,8 @@ PCL_EXPORTS void mergeSeedSegments(const MergeInput& input,
  *
  * \param[in] vertex_leaf \#V leaf of each vertex, -1: none
  * \param[in] num_leaves \#L
+ * \return the leaves in that order; empty, with a PCL_ERROR, when a vertex_leaf
+ *         entry is not below num_leaves
  */
 PCL_EXPORTS std::vector<pcl::index_t>
 seedOrder(const std::vector<pcl::index_t>& vertex_leaf, std::size_t num_leaves);
@@ -144,10 +145,9 @@ seedOrder(const std::vector<pcl::index_t>& vertex_leaf, std::size_t num_leaves);
  * \param[out] labels \#T labels (0 when no vertex is labeled)
  * \param[out] classes \#T classes
  *
- * Per-triangle arrays of another size, or an angle outside [0, pi] (NaN included),
- * give a PCL_ERROR and empty outputs. Not checked (a pass over the mesh, on the
- * pipeline's path): vertex ids below vertex_labels' size, and every vertex label at
- * most label_normals' size.
+ * Per-triangle arrays of another size, an angle outside [0, pi] (NaN included), a
+ * vertex id not below vertex_labels' size or a vertex label above label_normals' size
+ * give a PCL_ERROR and empty outputs.
  * \param[in] num_threads threads (0: defaultThreads()); the result does not
  *            depend on it
  */
@@ -164,7 +164,8 @@ PCL_EXPORTS void classifyTriangles(const std::vector<Triangle>& triangles,
 /** \brief Compressed incidence lists: the items of group g are
  * items[offsets[g] .. offsets[g + 1]), in increasing item order.
  * \param[in] group_of group of each item, negative = none
- * \param[in] num_groups number of groups */
+ * \param[in] num_groups number of groups (a group_of entry not below it: a
+ *            PCL_ERROR, and every group empty) */
 struct PCL_EXPORTS Incidence {
   std::vector<std::size_t> offsets;
   std::vector<pcl::index_t> items;
@@ -183,7 +184,8 @@ PCL_EXPORTS void clustersFromLabels(const std::vector<std::uint32_t>& labels,
                                     std::vector<pcl::PointIndices>& clusters,
                                     int num_threads = 1);
 
-/** \brief Triangles at each vertex, in increasing triangle order.
+/** \brief Triangles at each vertex, in increasing triangle order (a triangle naming
+ * a vertex not below num_vertices: a PCL_ERROR, and every list empty).
  * \param[in] num_threads threads (0: defaultThreads()); the result does not
  *            depend on it */
 PCL_EXPORTS Incidence vertexTriangles(const std::vector<Triangle>& triangles,

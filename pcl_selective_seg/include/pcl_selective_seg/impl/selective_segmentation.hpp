@@ -715,6 +715,9 @@ template <typename PointT>
 bool
 SelectiveSegmentation<PointT>::runExtract(std::vector<pcl::PointIndices>& clusters)
 {
+  // The meshes of this run are the triangulation's own: the mesh functions need not
+  // check their ids (the input is checked by initCompute() and the triangulation).
+  const detail::TrustedMeshScope trusted_mesh;
   clusters.clear();
   clearOutputs();
   previous_leaves_ = typename Octree::PreviousLeaves(); // from scratch

@@ -63,6 +63,7 @@ SelectiveSegmentation<PointT>::updateUnion(const PointCloud& new_points,
                                            bool in_place,
                                            std::vector<pcl::PointIndices>& clusters)
 {
+  const detail::TrustedMeshScope trusted_mesh; // as in runExtract()
   pcl::StopWatch total;
   update_stats_.new_points = new_points.size();
   const std::size_t first_new = input_->size();
