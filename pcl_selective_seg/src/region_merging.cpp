@@ -828,7 +828,7 @@ classifyTriangles(const std::vector<Triangle>& triangles,
                              "the triangles",
                              num_threads))
     broken = "the triangles' vertex ids do not fit vertex_labels (above)";
-  else if (!vertex_labels.empty() &&
+  else if (!detail::meshTrusted() && !vertex_labels.empty() &&
            *std::max_element(vertex_labels.begin(), vertex_labels.end()) >
                label_normals.size())
     broken = "a vertex label has no normal in label_normals (label l at [l - 1])";
