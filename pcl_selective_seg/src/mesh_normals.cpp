@@ -262,13 +262,10 @@ computeTriangleNormalsAndEdgeOn(const Vector3fVector& positions,
                                 int num_threads)
 {
   // The ids and sizes the passes below index with (mesh_checks.h).
-  if (!detail::idsBelow(triangles,
-                        positions.size(),
-                        false,
-                        "computeTriangleNormalsAndEdgeOn",
-                        "the triangles",
-                        num_threads) ||
-      !incidenceUsable(max_incidence, "computeTriangleNormalsAndEdgeOn")) {
+  const char* where = "computeTriangleNormalsAndEdgeOn";
+  if (!detail::idsBelow(
+          triangles, positions.size(), false, where, "the triangles", num_threads) ||
+      !incidenceUsable(max_incidence, where)) {
     normals.clear();
     areas.clear();
     edge_on.clear();
@@ -308,19 +305,13 @@ updateTriangleNormalsAndEdgeOn(const Vector3fVector& positions,
       !detail::idsBelow(
           changed, triangles.size(), false, where, "changed", num_threads))
     return; // the arrays as they were
-  if (!incidenceUsable(max_incidence, "updateTriangleNormalsAndEdgeOn") ||
-      normals.size() != old_to_new.size() || areas.size() != old_to_new.size() ||
-      edge_on.size() != old_to_new.size()) {
-    if (max_incidence >= 0.0)
-      PCL_ERROR("[pcl::selective_seg::updateTriangleNormalsAndEdgeOn] the old arrays "
-                "(%zu normals, %zu areas, %zu flags) need one entry per old triangle "
-                "(%zu)\n",
-                normals.size(),
-                areas.size(),
-                edge_on.size(),
-                old_to_new.size());
+  // The old arrays: one entry per old triangle.
+  const std::size_t n_old_triangles = old_to_new.size();
+  if (!incidenceUsable(max_incidence, where) ||
+      !detail::sizeIs(normals.size(), n_old_triangles, where, "the old normals") ||
+      !detail::sizeIs(areas.size(), n_old_triangles, where, "the old areas") ||
+      !detail::sizeIs(edge_on.size(), n_old_triangles, where, "the old edge-on flags"))
     return; // the arrays as they were
-  }
   const std::size_t n_new = triangles.size();
   Vector3fVector new_normals(n_new);
   std::vector<double> new_areas(n_new);
@@ -762,7 +753,7 @@ updateVertexNormalsOverRings(const std::vector<Triangle>& triangles,
       !detail::idsBelow(
           changed_triangles, triangles.size(), false, where, "changed_triangles"))
     return; // the normals as they were
-  if (!ringsUsable(rings, "updateVertexNormalsOverRings"))
+  if (!ringsUsable(rings, where))
     return; // the normals as they were
   // One triangle at each vertex met, for the walks around it.
   const std::size_t num_vertices = vertex_normals.size();
@@ -842,7 +833,7 @@ fillMissingVertexNormals(const std::vector<Triangle>& triangles,
                                       where,
                                       num_threads))
     return 0; // the normals as they were
-  if (!ringsUsable(rings, "fillMissingVertexNormals"))
+  if (!ringsUsable(rings, where))
     return 0; // the normals as they were
   const std::size_t num_vertices = vertex_normals.size();
   std::vector<pcl::index_t> missing;

@@ -736,6 +736,32 @@ private:
 
 } // namespace
 
+namespace {
+
+/** Whether \a angle lies in [0, pi] (not NaN), the range validate() gives eq. 8-9. */
+bool
+angleUsable(double angle)
+{
+  return angle >= 0.0 && angle <= M_PI;
+}
+
+/** What mergeSeedSegments() and classifyTriangles() both need of the mesh's
+ * per-triangle inputs and eq. 8's angle: nullptr, or what is wrong. */
+const char*
+triangleInputsBroken(std::size_t num_triangles,
+                     std::size_t num_normals,
+                     const std::vector<std::uint8_t>* edge_on,
+                     double max_edge_triangle_angle)
+{
+  if (num_normals != num_triangles || (edge_on && edge_on->size() != num_triangles))
+    return "triangle_normals (and triangle_edge_on) need one entry per triangle";
+  if (!angleUsable(max_edge_triangle_angle))
+    return "max_edge_triangle_angle must lie in [0, pi] rad";
+  return nullptr;
+}
+
+} // namespace
+
 std::vector<pcl::index_t>
 seedOrder(const std::vector<pcl::index_t>& vertex_leaf, std::size_t num_leaves)
 {
@@ -764,34 +790,35 @@ mergeSeedSegments(const MergeInput& input,
                   std::vector<pcl::index_t>& leaf_segment,
                   Vector3fVector& segment_normals)
 {
-  const char* missing = nullptr;
-  if (!input.vertex_leaf || !input.triangles || !input.triangle_normals)
-    missing = "vertex_leaf, triangles and triangle_normals are required";
-  else if (!input.leaves && (!input.leaf_normals || !input.leaf_areas))
-    missing = "leaves, or leaf_normals and leaf_areas, are required";
-  else if (!input.leaves && input.leaf_normals->size() != input.leaf_areas->size())
-    missing = "leaf_normals and leaf_areas differ in size";
-  else if (input.triangle_normals->size() != input.triangles->size() ||
-           (input.triangle_edge_on &&
-            input.triangle_edge_on->size() != input.triangles->size()))
-    missing = "triangle_normals (and triangle_edge_on) need one entry per triangle";
-  else if (!(input.max_merge_angle >= 0.0 && input.max_merge_angle <= M_PI) ||
-           !(input.max_edge_triangle_angle >= 0.0 &&
-             input.max_edge_triangle_angle <= M_PI))
-    missing = "max_merge_angle and max_edge_triangle_angle must lie in [0, pi] rad";
-  else if (!detail::idsBelow(*input.triangles,
-                             input.vertex_leaf->size(),
-                             false,
-                             "mergeSeedSegments",
-                             "the triangles",
-                             input.num_threads) ||
-           !detail::idsBelow(*input.vertex_leaf,
-                             numLeaves(input),
-                             true,
-                             "mergeSeedSegments",
-                             "vertex_leaf",
-                             input.num_threads))
-    missing = "the mesh's ids do not fit its arrays (above)";
+  const char* missing = [&]() -> const char* {
+    if (!input.vertex_leaf || !input.triangles || !input.triangle_normals)
+      return "vertex_leaf, triangles and triangle_normals are required";
+    if (!input.leaves && (!input.leaf_normals || !input.leaf_areas))
+      return "leaves, or leaf_normals and leaf_areas, are required";
+    if (!input.leaves && input.leaf_normals->size() != input.leaf_areas->size())
+      return "leaf_normals and leaf_areas differ in size";
+    if (const char* broken = triangleInputsBroken(input.triangles->size(),
+                                                  input.triangle_normals->size(),
+                                                  input.triangle_edge_on,
+                                                  input.max_edge_triangle_angle))
+      return broken;
+    if (!angleUsable(input.max_merge_angle))
+      return "max_merge_angle must lie in [0, pi] rad";
+    if (!detail::idsBelow(*input.triangles,
+                          input.vertex_leaf->size(),
+                          false,
+                          "mergeSeedSegments",
+                          "the triangles",
+                          input.num_threads) ||
+        !detail::idsBelow(*input.vertex_leaf,
+                          numLeaves(input),
+                          true,
+                          "mergeSeedSegments",
+                          "vertex_leaf",
+                          input.num_threads))
+      return "the mesh's ids do not fit its arrays (above)";
+    return nullptr;
+  }();
   if (missing) {
     PCL_ERROR("[pcl::selective_seg::mergeSeedSegments] %s\n", missing);
     leaf_segment.clear();
@@ -815,23 +842,25 @@ classifyTriangles(const std::vector<Triangle>& triangles,
                   std::vector<TriangleClass>& classes,
                   int num_threads)
 {
-  const char* broken = nullptr;
-  if (triangle_normals.size() != triangles.size() ||
-      (triangle_edge_on && triangle_edge_on->size() != triangles.size()))
-    broken = "triangle_normals (and triangle_edge_on) need one entry per triangle";
-  else if (!(max_edge_triangle_angle >= 0.0 && max_edge_triangle_angle <= M_PI))
-    broken = "max_edge_triangle_angle must lie in [0, pi] rad";
-  else if (!detail::idsBelow(triangles,
-                             vertex_labels.size(),
-                             false,
-                             "classifyTriangles",
-                             "the triangles",
-                             num_threads))
-    broken = "the triangles' vertex ids do not fit vertex_labels (above)";
-  else if (!detail::meshTrusted() && !vertex_labels.empty() &&
-           *std::max_element(vertex_labels.begin(), vertex_labels.end()) >
-               label_normals.size())
-    broken = "a vertex label has no normal in label_normals (label l at [l - 1])";
+  const char* broken = [&]() -> const char* {
+    if (const char* wrong = triangleInputsBroken(triangles.size(),
+                                                 triangle_normals.size(),
+                                                 triangle_edge_on,
+                                                 max_edge_triangle_angle))
+      return wrong;
+    if (!detail::idsBelow(triangles,
+                          vertex_labels.size(),
+                          false,
+                          "classifyTriangles",
+                          "the triangles",
+                          num_threads))
+      return "the triangles' vertex ids do not fit vertex_labels (above)";
+    if (!detail::meshTrusted() && !vertex_labels.empty() &&
+        *std::max_element(vertex_labels.begin(), vertex_labels.end()) >
+            label_normals.size())
+      return "a vertex label has no normal in label_normals (label l at [l - 1])";
+    return nullptr;
+  }();
   if (broken) {
     PCL_ERROR("[pcl::selective_seg::classifyTriangles] %s\n", broken);
     labels.clear();

@@ -54,7 +54,8 @@ namespace detail {
 /** \brief While one lives on a thread, the mesh functions called on that thread
  * (mesh_normals.h, region_merging.h, computeTriangleNeighbours()) skip the pass that
  * checks their ids: SelectiveSegmentation holds one during a run, whose meshes meet
- * the checks by construction (each pass would cost it about 0.5% at 46k points).
+ * the checks by construction (the passes together cost 2-4% at 46k points;
+ * docs/reliability.md, "Review of session 36").
  * Nests; not for users' own meshes. */
 class PCL_EXPORTS TrustedMeshScope {
 public:
