@@ -25,7 +25,8 @@ def load(path):
         name = b["name"]
         if b.get("aggregate_name") not in (None, "median"):
             continue
-        key = re.sub(r"/repeats:\d+|/iterations:\d+|/real_time|_median", "", name)
+        key = re.sub(r"/repeats:\d+|/iterations:\d+|/min_time:[\d.]+|/real_time|_median",
+                     "", name)
         runs[key] = b
     return data.get("context", {}), runs
 
@@ -55,6 +56,37 @@ def door_rows(runs):
         rg = runs.get(f"BM_RegionGrowing_Door/{m.group(1)}")
         rows.append((int(b["points"]), b, rg))
     return rows
+
+
+def frame_loop_lines(runs, rows):
+    """The table of frames segmented one after another (BM_FrameLoop_Door) beside the
+    door table's runs (a new segmenter each, repetitions among the other sizes')."""
+    # A run's name is BM_Pipeline_Door/<size asked for>/...: the same size's loop.
+    loop = {n: runs.get(f"BM_FrameLoop_Door/{b['name'].split('/')[1]}")
+            for n, b, _ in rows}
+    if not any(loop.values()):
+        return []
+    out = ["", "## Frames one after another", "",
+           "`BM_FrameLoop_Door`: one segmenter segments the same scan again and again "
+           "after a first frame that is not timed, as a program that segments a "
+           "sensor's frames holds it (median of 3 repetitions of at least 4 s of "
+           "frames each); beside it the table above's runs, whose repetitions fall "
+           "among the other sizes' and the peer's and find memory that those freed. "
+           "Page faults per frame from `getrusage` (the memory the process mapped "
+           "afresh; each costs microseconds on a virtual machine).", "",
+           "| points | new segmenter, among other sizes (s) | page faults per frame | "
+           "frame loop (s) | page faults per frame |", "|---|---|---|---|---|"]
+    for n, b, _ in rows:
+        f = loop.get(n)
+        if f:
+            out.append(f"| {n:,} | {seconds(b):.4f} | {b.get('faults', 0):,.0f} | "
+                       f"{seconds(f):.4f} | {f.get('faults', 0):,.0f} |")
+    big = [(n, b, loop.get(n)) for n, b, _ in rows if n >= 900000]
+    if len(big) == 2 and big[0][2] and big[1][2]:
+        out += ["", f"3M / 1M: {seconds(big[1][1]) / seconds(big[0][1]):.2f} with a new "
+                f"segmenter among the other sizes, "
+                f"{seconds(big[1][2]) / seconds(big[0][2]):.2f} in the frame loop."]
+    return out
 
 
 def write_plot(rows, plot):
@@ -149,6 +181,7 @@ def markdown(context, runs, rows, memory, load=None, probe=None):
         out.append(f"| {n:,} | {b['delaunay_s']:.4f} | {b['normals_s']:.4f} | "
                    f"{b['octree_s']:.4f} | {b['merge_s']:.4f} | {total:.4f} | "
                    f"{seconds(rg):.3f} | {ratio} |" if rg else "")
+    out += frame_loop_lines(runs, rows)
     out += ["", "The paper's Table I (Pentium IV 3.4 GHz, 2008):", "",
             "| data set | points | Delaunay (s) | Normal Calc. (s) | Octree Gen. (s) | "
             "Merge Voxels (s) | Total (s) |", "|---|---|---|---|---|---|---|"]
