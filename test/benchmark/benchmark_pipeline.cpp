@@ -20,13 +20,12 @@
 #include <pcl/search/kdtree.h>
 #include <pcl/segmentation/region_growing.h>
 
-#include <sys/resource.h>
-
 #include <cstdlib>
 #include <map>
 #include <string>
 
 #include "door_scan.h"
+#include "page_faults.h"
 
 namespace {
 
@@ -61,21 +60,14 @@ realFrame(const std::string& relative)
   return cloud;
 }
 
-/** The minor page faults of this process so far. */
-double
-minorFaults()
-{
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return static_cast<double>(usage.ru_minflt);
-}
-
 /** The pipeline on \a cloud: a new segmenter each iteration, or (\a frame_loop) one
  * segmenter for every iteration after a first frame that is not timed, as a program
  * segmenting a sensor's frames one after another holds it. The counter "faults" is the
  * page faults per timed iteration (the cost of memory the process maps afresh). */
 void
-runPipeline(benchmark::State& state, const Cloud::ConstPtr& cloud, bool frame_loop = false)
+runPipeline(benchmark::State& state,
+            const Cloud::ConstPtr& cloud,
+            bool frame_loop = false)
 {
   if (!cloud) {
     state.SkipWithError("cloud not available (set SELSEG_DATA)");
@@ -92,7 +84,7 @@ runPipeline(benchmark::State& state, const Cloud::ConstPtr& cloud, bool frame_lo
       return;
     }
   }
-  const double faults_before = minorFaults();
+  const double faults_before = selseg_bench::minorFaults();
   for (auto _ : state) {
     pcl::selective_seg::SelectiveSegmentation<pcl::PointXYZ> fresh;
     auto& seg = frame_loop ? kept : fresh;
@@ -116,7 +108,8 @@ runPipeline(benchmark::State& state, const Cloud::ConstPtr& cloud, bool frame_lo
   state.counters["normals_s"] = benchmark::Counter(sum.normals, avg);
   state.counters["octree_s"] = benchmark::Counter(sum.octree, avg);
   state.counters["merge_s"] = benchmark::Counter(sum.merge, avg);
-  state.counters["faults"] = benchmark::Counter(minorFaults() - faults_before, avg);
+  state.counters["faults"] =
+      benchmark::Counter(selseg_bench::minorFaults() - faults_before, avg);
 }
 
 /** The PCL tutorial's region growing: 30-neighbour normals (OpenMP, both cores),

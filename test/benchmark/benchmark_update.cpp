@@ -18,6 +18,7 @@
 #include <map>
 
 #include "door_scan.h"
+#include "page_faults.h"
 
 namespace {
 
@@ -72,8 +73,11 @@ BM_ExtractUnion(benchmark::State& state)
   pcl::selective_seg::SelectiveSegmentation<pcl::PointXYZ> seg;
   seg.setMinVoxelSize(first.getResult().min_voxel_size); // as update() keeps it
   seg.setInputCloud(s.all);
+  const double faults_before = selseg_bench::minorFaults();
   for (auto _ : state)
     benchmark::DoNotOptimize(seg.extract(clusters));
+  state.counters["faults"] = benchmark::Counter(
+      selseg_bench::minorFaults() - faults_before, benchmark::Counter::kAvgIterations);
   setTimings(state, seg.getResult());
   state.counters["points"] = static_cast<double>(s.all->size());
   state.counters["window_points"] = static_cast<double>(s.fine->size());
@@ -85,13 +89,20 @@ BM_Update(benchmark::State& state)
   const Scenario& s = scenario(static_cast<std::size_t>(state.range(0)));
   pcl::selective_seg::SelectiveSegmentation<pcl::PointXYZ> seg;
   std::vector<pcl::PointIndices> clusters;
+  double faults = 0.0; // those of the updates only
   for (auto _ : state) {
     state.PauseTiming();
     seg.setInputCloud(s.coarse);
     seg.extract(clusters);
+    const double before = selseg_bench::minorFaults();
     state.ResumeTiming();
     benchmark::DoNotOptimize(seg.update(*s.fine, clusters));
+    state.PauseTiming();
+    faults += selseg_bench::minorFaults() - before;
+    state.ResumeTiming();
   }
+  state.counters["faults"] =
+      benchmark::Counter(faults, benchmark::Counter::kAvgIterations);
   setTimings(state, seg.getResult());
   const auto& u = seg.getUpdateStatistics();
   state.counters["incremental"] = u.incremental;
