@@ -8,10 +8,12 @@
 // input and the agreement of the labels, the mesh and the octree.
 
 #include <pcl_selective_seg/point_types.h>
+#include <pcl_selective_seg/segment_colors.h>
 #include <pcl_selective_seg/selective_segmentation.h>
 
 #include <boost/preprocessor/seq/enum.hpp>
 #include <gtest/gtest.h>
+#include <pcl/common/io.h>
 #include <pcl/common/transforms.h>
 #include <pcl/conversions.h>
 
@@ -370,6 +372,97 @@ TEST(SelectiveSegmentation, LabelsMeshAndOctreeAgree)
 // which is the order of their seeds: a segment grows from its first leaf in the seed
 // order (most vertices first, ties by leaf index), so the rank comes from the result's
 // leaves alone. The cube scene's many small edge segments share sizes.
+// The segment colours, computed by hand: hue = label x 137.50776405 degrees (mod
+// 360), HSV with S = V = 1; label 0 dark grey; edge triangles white.
+TEST(SegmentColors, GoldenAngleHuesByHand)
+{
+  using pcl::selective_seg::Rgb;
+  using pcl::selective_seg::segmentColor;
+  using pcl::selective_seg::TriangleClass;
+  using pcl::selective_seg::triangleColor;
+  EXPECT_EQ(segmentColor(0), (Rgb{64, 64, 64}));
+  // 137.5 deg: sector 2 (green to cyan), f = 0.2918 -> blue 74.
+  EXPECT_EQ(segmentColor(1), (Rgb{0, 255, 74}));
+  // 275.0 deg: sector 4 (blue to magenta), f = 0.5836 -> red 149.
+  EXPECT_EQ(segmentColor(2), (Rgb{149, 0, 255}));
+  // 412.5 - 360 = 52.5 deg: sector 0 (red to yellow), f = 0.8754 -> green 223.
+  EXPECT_EQ(segmentColor(3), (Rgb{255, 223, 0}));
+  EXPECT_EQ(triangleColor(3, TriangleClass::Interior), segmentColor(3));
+  EXPECT_EQ(triangleColor(3, TriangleClass::ValidEdge), (Rgb{255, 255, 255}));
+  EXPECT_EQ(triangleColor(3, TriangleClass::InvalidEdge), (Rgb{255, 255, 255}));
+  // Neighbouring labels (segments of similar sizes) never share a colour, and the
+  // first hundred are all distinct.
+  std::set<Rgb> first;
+  for (std::uint32_t l = 1; l <= 100; ++l)
+    first.insert(segmentColor(l));
+  EXPECT_EQ(first.size(), 100u);
+  for (std::uint32_t l = 1; l < 100000; ++l)
+    ASSERT_NE(segmentColor(l), segmentColor(l + 1)) << l;
+}
+
+// getColoredCloud() is getLabeledCloud() with segmentColor() of each label: same
+// points, layout and pose; null before a run and after a failed one.
+TEST(SelectiveSegmentation, ColoredCloudColoursEachPointByItsSegment)
+{
+  const auto scene = cubeScene(3000);
+  auto cloud = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  pcl::copyPointCloud(*scene, *cloud);
+  // A point without a label: behind the sensor.
+  cloud->push_back(pcl::PointXYZ(0.0f, 0.0f, -1.0f));
+  cloud->width = static_cast<std::uint32_t>(cloud->size());
+  cloud->height = 1;
+  SelectiveSegmentation<pcl::PointXYZ> seg;
+  EXPECT_FALSE(seg.getColoredCloud());
+  EXPECT_FALSE(seg.getColoredCloudRGBA());
+  std::vector<pcl::PointIndices> clusters;
+  ASSERT_TRUE(segment<pcl::PointXYZ>(cloud, seg, clusters));
+  const auto labeled = seg.getLabeledCloud();
+  const auto colored = seg.getColoredCloud();
+  const auto rgba = seg.getColoredCloudRGBA();
+  ASSERT_TRUE(labeled);
+  ASSERT_TRUE(colored);
+  ASSERT_TRUE(rgba);
+  ASSERT_EQ(colored->size(), labeled->size());
+  ASSERT_EQ(rgba->size(), labeled->size());
+  EXPECT_EQ(colored->width, labeled->width);
+  EXPECT_EQ(colored->height, labeled->height);
+  EXPECT_EQ(colored->is_dense, labeled->is_dense);
+  EXPECT_EQ(colored->sensor_origin_, labeled->sensor_origin_);
+  EXPECT_TRUE(colored->sensor_orientation_.isApprox(labeled->sensor_orientation_));
+  EXPECT_EQ(rgba->width, labeled->width);
+  EXPECT_EQ(rgba->height, labeled->height);
+  std::map<std::uint32_t, pcl::selective_seg::Rgb> seen;
+  std::size_t unlabeled = 0;
+  for (std::size_t i = 0; i < labeled->size(); ++i) {
+    const auto& l = (*labeled)[i];
+    const auto& c = (*colored)[i];
+    const auto& a = (*rgba)[i];
+    ASSERT_EQ(c.getVector3fMap(), l.getVector3fMap()) << i;
+    ASSERT_EQ(a.getVector3fMap(), l.getVector3fMap()) << i;
+    const pcl::selective_seg::Rgb got{c.r, c.g, c.b};
+    ASSERT_EQ(got, pcl::selective_seg::segmentColor(l.label)) << i;
+    ASSERT_EQ((pcl::selective_seg::Rgb{a.r, a.g, a.b}), got) << i;
+    ASSERT_EQ(a.a, 255) << i;
+    seen.emplace(l.label, got);
+    unlabeled += l.label == 0;
+  }
+  EXPECT_EQ(unlabeled, 1u);
+  EXPECT_EQ((*colored)[cloud->size() - 1].r, 64);
+  // One colour per segment, and no two segments alike (the cube has few).
+  std::set<pcl::selective_seg::Rgb> colours;
+  for (const auto& [label, rgb] : seen)
+    colours.insert(rgb);
+  EXPECT_EQ(colours.size(), seen.size());
+  EXPECT_EQ(seen.size(), clusters.size() + 1);
+
+  // A failed run: no colours.
+  auto tiny = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  tiny->push_back(pcl::PointXYZ(0.0f, 0.0f, 1.0f));
+  EXPECT_FALSE(segment<pcl::PointXYZ>(tiny, seg, clusters));
+  EXPECT_FALSE(seg.getColoredCloud());
+  EXPECT_FALSE(seg.getColoredCloudRGBA());
+}
+
 TEST(SelectiveSegmentation, SegmentsOfOneSizeAreRankedInTheOrderTheyGrew)
 {
   const auto cloud = cubeScene(20000, 3);

@@ -137,6 +137,8 @@ public:
   using ConstPtr = pcl::shared_ptr<const SelectiveSegmentation<PointT>>;
   using PointCloud = pcl::PointCloud<PointT>;
   using LabeledCloud = pcl::PointCloud<pcl::PointXYZL>;
+  using ColoredCloud = pcl::PointCloud<pcl::PointXYZRGB>;
+  using ColoredCloudRGBA = pcl::PointCloud<pcl::PointXYZRGBA>;
   using NormalCloud = pcl::PointCloud<pcl::Normal>;
   /** The octree over the mesh vertices in the sensor frame (point i = vertex i). */
   using Octree = OctreePointCloudNormalVariance<pcl::PointXYZ>;
@@ -300,6 +302,16 @@ public:
    * may be called from several threads at once. */
   LabeledCloud::Ptr getLabeledCloud() const;
 
+  /** \brief getLabeledCloud() with a colour per segment instead of the label, as
+   * pcl::RegionGrowing::getColoredCloud() gives, for a look at the result: each point
+   * has segmentColor() of its label (segment_colors.h: one hue per label, the same in
+   * every run and as the tool's meshes and the viewer; unlabeled points dark grey).
+   * Same size, order, layout and sensor pose as getLabeledCloud(); null when it is. */
+  ColoredCloud::Ptr getColoredCloud() const;
+
+  /** \brief getColoredCloud() as pcl::PointXYZRGBA, alpha 255. */
+  ColoredCloudRGBA::Ptr getColoredCloudRGBA() const;
+
   /** \brief Point normals (eq. 2) in the cloud frame of the last run (its sensor
    * pose), oriented toward the sensor; same size and layout as getLabeledCloud(); NaN
    * where a point has no normal. Null before a successful extract(). Built from the
@@ -434,6 +446,9 @@ protected:
   template <typename CloudT>
   pcl::shared_ptr<CloudT>
   cloudShapedLikeTheRun(const typename CloudT::PointType& fill) const;
+
+  /** \brief getColoredCloud() for any PCL point type with x, y, z and r, g, b. */
+  template <typename CloudT> pcl::shared_ptr<CloudT> coloredCloud() const;
 
 private:
   SelectiveSegmentationParameters params_;

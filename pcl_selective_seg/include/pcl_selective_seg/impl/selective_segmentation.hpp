@@ -9,6 +9,7 @@
 #include <pcl_selective_seg/impl/large_arrays.hpp>
 #include <pcl_selective_seg/impl/spherical_delaunay.hpp>
 #include <pcl_selective_seg/region_merging.h>
+#include <pcl_selective_seg/segment_colors.h>
 #include <pcl_selective_seg/selective_segmentation.h>
 
 #include <pcl/common/time.h>
@@ -858,6 +859,49 @@ SelectiveSegmentation<PointT>::getLabeledCloud() const
     (*out)[i].label = result_.labels[i];
   }
   return out;
+}
+
+template <typename PointT>
+template <typename CloudT>
+pcl::shared_ptr<CloudT>
+SelectiveSegmentation<PointT>::coloredCloud() const
+{
+  if (!mesh_input_ || result_.segments.empty() ||
+      result_.labels.size() != mesh_input_->size())
+    return nullptr;
+  const PointCloud& run = *mesh_input_;
+  auto out = cloudShapedLikeTheRun<CloudT>(typename CloudT::PointType());
+  out->is_dense = run.is_dense;
+  out->sensor_origin_ = run.sensor_origin_;
+  out->sensor_orientation_ = run.sensor_orientation_;
+  // One colour per label, looked up (the labels are 0 .. #segments).
+  std::vector<Rgb> colors(result_.segments.size() + 1);
+  for (std::size_t l = 0; l < colors.size(); ++l)
+    colors[l] = segmentColor(static_cast<std::uint32_t>(l));
+  for (std::size_t i = 0; i < run.size(); ++i) {
+    auto& p = (*out)[i];
+    p.getVector3fMap() = run[i].getVector3fMap();
+    const Rgb& c = colors[result_.labels[i]];
+    p.r = c[0];
+    p.g = c[1];
+    p.b = c[2];
+    p.a = 255;
+  }
+  return out;
+}
+
+template <typename PointT>
+typename SelectiveSegmentation<PointT>::ColoredCloud::Ptr
+SelectiveSegmentation<PointT>::getColoredCloud() const
+{
+  return coloredCloud<ColoredCloud>();
+}
+
+template <typename PointT>
+typename SelectiveSegmentation<PointT>::ColoredCloudRGBA::Ptr
+SelectiveSegmentation<PointT>::getColoredCloudRGBA() const
+{
+  return coloredCloud<ColoredCloudRGBA>();
 }
 
 template <typename PointT>

@@ -4,11 +4,12 @@
  *  pcl_selective_seg: segmentation of 3-D surface point clouds for selective sensing.
  */
 
-#include "segment_colors.h"
+#include <pcl_selective_seg/segment_colors.h>
 
 #include <cmath>
 
-namespace selseg_apps {
+namespace pcl {
+namespace selective_seg {
 
 Rgb
 segmentColor(std::uint32_t label)
@@ -40,11 +41,12 @@ segmentColor(std::uint32_t label)
 }
 
 Rgb
-triangleColor(std::uint32_t label, pcl::selective_seg::TriangleClass cls)
+triangleColor(std::uint32_t label, TriangleClass cls)
 {
-  if (cls != pcl::selective_seg::TriangleClass::Interior)
+  if (cls != TriangleClass::Interior)
     return {255, 255, 255};
   return segmentColor(label);
 }
 
-} // namespace selseg_apps
+} // namespace selective_seg
+} // namespace pcl
