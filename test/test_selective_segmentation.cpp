@@ -368,10 +368,6 @@ TEST(SelectiveSegmentation, LabelsMeshAndOctreeAgree)
   }
 }
 
-// Labels rank segments by size; segments of one size keep the order in which they grew,
-// which is the order of their seeds: a segment grows from its first leaf in the seed
-// order (most vertices first, ties by leaf index), so the rank comes from the result's
-// leaves alone. The cube scene's many small edge segments share sizes.
 // The segment colours, computed by hand: hue = label x 137.50776405 degrees (mod
 // 360), HSV with S = V = 1; label 0 dark grey; edge triangles white.
 TEST(SegmentColors, GoldenAngleHuesByHand)
@@ -398,6 +394,10 @@ TEST(SegmentColors, GoldenAngleHuesByHand)
   EXPECT_EQ(first.size(), 100u);
   for (std::uint32_t l = 1; l < 100000; ++l)
     ASSERT_NE(segmentColor(l), segmentColor(l + 1)) << l;
+  const auto table = pcl::selective_seg::segmentColors(3);
+  ASSERT_EQ(table.size(), 4u);
+  for (std::uint32_t l = 0; l <= 3; ++l)
+    EXPECT_EQ(table[l], segmentColor(l)) << l;
 }
 
 // getColoredCloud() is getLabeledCloud() with segmentColor() of each label: same
@@ -463,6 +463,10 @@ TEST(SelectiveSegmentation, ColoredCloudColoursEachPointByItsSegment)
   EXPECT_FALSE(seg.getColoredCloudRGBA());
 }
 
+// Labels rank segments by size; segments of one size keep the order in which they grew,
+// which is the order of their seeds: a segment grows from its first leaf in the seed
+// order (most vertices first, ties by leaf index), so the rank comes from the result's
+// leaves alone. The cube scene's many small edge segments share sizes.
 TEST(SelectiveSegmentation, SegmentsOfOneSizeAreRankedInTheOrderTheyGrew)
 {
   const auto cloud = cubeScene(20000, 3);

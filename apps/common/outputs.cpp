@@ -166,10 +166,7 @@ labelColors(const SegmentedMesh& mesh)
   std::uint32_t max_label = 0;
   for (const auto l : mesh.labels)
     max_label = std::max(max_label, l);
-  std::vector<Rgb> colors(std::size_t{max_label} + 1);
-  for (std::uint32_t l = 0; l <= max_label; ++l)
-    colors[l] = segmentColor(l);
-  return colors;
+  return pcl::selective_seg::segmentColors(max_label);
 }
 
 /** triangleColor() of triangle \a t, an interior one's from the table of

@@ -40,6 +40,15 @@ segmentColor(std::uint32_t label)
   }
 }
 
+std::vector<Rgb>
+segmentColors(std::uint32_t max_label)
+{
+  std::vector<Rgb> colors(std::size_t{max_label} + 1);
+  for (std::uint32_t l = 0; l <= max_label; ++l)
+    colors[l] = segmentColor(l);
+  return colors;
+}
+
 Rgb
 triangleColor(std::uint32_t label, TriangleClass cls)
 {

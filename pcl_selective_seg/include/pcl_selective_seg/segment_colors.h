@@ -12,6 +12,7 @@
 
 #include <array>
 #include <cstdint>
+#include <vector>
 
 namespace pcl {
 namespace selective_seg {
@@ -26,6 +27,10 @@ using Rgb = std::array<std::uint8_t, 3>;
  * has the same colour in every run: the command-line tool's meshes, the viewer and
  * SelectiveSegmentation::getColoredCloud() use it. */
 PCL_EXPORTS Rgb segmentColor(std::uint32_t label);
+
+/** \brief segmentColor() of labels 0 .. \a max_label, indexed by label: a table for
+ * colouring many points or triangles. */
+PCL_EXPORTS std::vector<Rgb> segmentColors(std::uint32_t max_label);
 
 /** \brief The colour of a mesh triangle: its segment's colour (segmentColor()) when
  * interior, white for an edge triangle (valid or invalid), as in the paper's figures. */

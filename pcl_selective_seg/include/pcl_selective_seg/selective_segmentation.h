@@ -447,7 +447,17 @@ protected:
   pcl::shared_ptr<CloudT>
   cloudShapedLikeTheRun(const typename CloudT::PointType& fill) const;
 
-  /** \brief getColoredCloud() for any PCL point type with x, y, z and r, g, b. */
+  /** \brief Whether the last run succeeded on the cloud it kept (the getters' outputs
+   * exist). */
+  bool hasRunOutputs() const;
+
+  /** \brief Null unless hasRunOutputs(); otherwise the run's points in a cloud shaped
+   * like it (size, layout, header, density, sensor pose), fill(point, label) setting
+   * each point's other fields from its label. */
+  template <typename CloudT, typename Fill>
+  pcl::shared_ptr<CloudT> runPointsCloud(const Fill& fill) const;
+
+  /** \brief getColoredCloud() for any PCL point type with x, y, z and r, g, b, a. */
   template <typename CloudT> pcl::shared_ptr<CloudT> coloredCloud() const;
 
 private:

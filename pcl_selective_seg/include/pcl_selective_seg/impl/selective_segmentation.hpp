@@ -842,23 +842,40 @@ SelectiveSegmentation<PointT>::getPointNormals() const
 }
 
 template <typename PointT>
-typename SelectiveSegmentation<PointT>::LabeledCloud::Ptr
-SelectiveSegmentation<PointT>::getLabeledCloud() const
+bool
+SelectiveSegmentation<PointT>::hasRunOutputs() const
 {
   // A successful run has at least one segment.
-  if (!mesh_input_ || result_.segments.empty() ||
-      result_.labels.size() != mesh_input_->size())
+  return mesh_input_ && !result_.segments.empty() &&
+         result_.labels.size() == mesh_input_->size();
+}
+
+template <typename PointT>
+template <typename CloudT, typename Fill>
+pcl::shared_ptr<CloudT>
+SelectiveSegmentation<PointT>::runPointsCloud(const Fill& fill) const
+{
+  if (!hasRunOutputs())
     return nullptr;
   const PointCloud& run = *mesh_input_;
-  auto out = cloudShapedLikeTheRun<LabeledCloud>(pcl::PointXYZL());
+  auto out = cloudShapedLikeTheRun<CloudT>(typename CloudT::PointType());
   out->is_dense = run.is_dense;
   out->sensor_origin_ = run.sensor_origin_;
   out->sensor_orientation_ = run.sensor_orientation_;
   for (std::size_t i = 0; i < run.size(); ++i) {
-    (*out)[i].getVector3fMap() = run[i].getVector3fMap();
-    (*out)[i].label = result_.labels[i];
+    auto& p = (*out)[i];
+    p.getVector3fMap() = run[i].getVector3fMap();
+    fill(p, result_.labels[i]);
   }
   return out;
+}
+
+template <typename PointT>
+typename SelectiveSegmentation<PointT>::LabeledCloud::Ptr
+SelectiveSegmentation<PointT>::getLabeledCloud() const
+{
+  return runPointsCloud<LabeledCloud>(
+      [](pcl::PointXYZL& p, std::uint32_t label) { p.label = label; });
 }
 
 template <typename PointT>
@@ -866,28 +883,17 @@ template <typename CloudT>
 pcl::shared_ptr<CloudT>
 SelectiveSegmentation<PointT>::coloredCloud() const
 {
-  if (!mesh_input_ || result_.segments.empty() ||
-      result_.labels.size() != mesh_input_->size())
-    return nullptr;
-  const PointCloud& run = *mesh_input_;
-  auto out = cloudShapedLikeTheRun<CloudT>(typename CloudT::PointType());
-  out->is_dense = run.is_dense;
-  out->sensor_origin_ = run.sensor_origin_;
-  out->sensor_orientation_ = run.sensor_orientation_;
-  // One colour per label, looked up (the labels are 0 .. #segments).
-  std::vector<Rgb> colors(result_.segments.size() + 1);
-  for (std::size_t l = 0; l < colors.size(); ++l)
-    colors[l] = segmentColor(static_cast<std::uint32_t>(l));
-  for (std::size_t i = 0; i < run.size(); ++i) {
-    auto& p = (*out)[i];
-    p.getVector3fMap() = run[i].getVector3fMap();
-    const Rgb& c = colors[result_.labels[i]];
-    p.r = c[0];
-    p.g = c[1];
-    p.b = c[2];
-    p.a = 255;
-  }
-  return out;
+  // The labels are 0 .. #segments.
+  const std::vector<Rgb> colors =
+      segmentColors(static_cast<std::uint32_t>(result_.segments.size()));
+  return runPointsCloud<CloudT>(
+      [&](typename CloudT::PointType& p, std::uint32_t label) {
+        const Rgb& c = colors[label];
+        p.r = c[0];
+        p.g = c[1];
+        p.b = c[2];
+        p.a = 255;
+      });
 }
 
 template <typename PointT>
@@ -909,8 +915,7 @@ void
 SelectiveSegmentation<PointT>::getPolygonMesh(pcl::PolygonMesh& mesh) const
 {
   mesh = pcl::PolygonMesh();
-  if (!mesh_input_ || result_.segments.empty() ||
-      result_.labels.size() != mesh_input_->size())
+  if (!hasRunOutputs())
     return;
   pcl::toPCLPointCloud2(*mesh_input_, mesh.cloud);
   // A declared layout that is not the cloud's size would make a blob whose rows
